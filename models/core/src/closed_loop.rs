@@ -1,0 +1,441 @@
+//! The closed loop of the paper's Fig. 4: `step5` reference → PID → tension distribution → cable
+//! model, as one ODE, and the runner that integrates it, samples it and stops with a reason.
+//!
+//! State layout: `[model state (n) | w | f | W | D]`: the PID integral and filter states, then two
+//! audit states excluded from the error norm, the reels' work W = ∫ Σ T_i v_reel,i dt and the energy
+//! dissipated inside the model D. They make the energy balance E(t) − E(0) − W(t) + D(t) = 0 a
+//! channel of every run.
+
+use crate::controller::{Pid, PidState, TensionDistribution};
+use crate::integrate::{Dopri5, Dopri5Options, IntegratorError, OdeSystem, SolverStats};
+use crate::model::{CableModel, Equilibrium, ModelError};
+use crate::scenario::{IntegratorKind, Scenario};
+use crate::series::TimeSeries;
+use crate::trajectory::Step5;
+use std::time::Instant;
+
+/// Where the commanded tensions come from.
+pub enum Actuation {
+    /// The paper's PID and tension distribution.
+    Pid,
+    /// Tensions prescribed as functions of time [s] → [T1, T2] [N]; the PID states still integrate
+    /// the error but do not act (energy and verification runs).
+    Prescribed(Box<dyn Fn(f64) -> [f64; 2] + Send + Sync>),
+}
+
+/// What the controller commands at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Command {
+    /// x_ref [m].
+    pub reference: f64,
+    /// e = x_ref − x [m].
+    pub error: f64,
+    /// PID force F [N] (pulls toward A2 when positive).
+    pub force: f64,
+    /// Commanded tensions [T1, T2] [N].
+    pub tensions: [f64; 2],
+}
+
+/// Model + controller as one [`OdeSystem`].
+pub struct ClosedLoop<M: CableModel> {
+    pub model: M,
+    pub trajectory: Step5,
+    pub pid: Pid,
+    pub distribution: TensionDistribution,
+    pub actuation: Actuation,
+}
+
+/// Number of controller and audit states after the model's.
+pub const EXTRA_STATES: usize = 4;
+
+impl<M: CableModel> ClosedLoop<M> {
+    /// The paper's loop for `model` with the scenario's controller and trajectory.
+    pub fn new(model: M, scenario: &Scenario) -> Self {
+        Self {
+            model,
+            trajectory: Step5::from(&scenario.trajectory),
+            pid: Pid::from(&scenario.controller),
+            distribution: TensionDistribution::from(&scenario.controller),
+            actuation: Actuation::Pid,
+        }
+    }
+
+    /// Length of the model's part of the state.
+    pub fn model_len(&self) -> usize {
+        self.model.state_len()
+    }
+
+    /// Splits a closed-loop state into the model state and the PID state.
+    pub fn split<'a>(&self, y: &'a [f64]) -> (&'a [f64], PidState) {
+        let n = self.model_len();
+        (
+            &y[..n],
+            PidState {
+                integral: y[n],
+                filter: y[n + 1],
+            },
+        )
+    }
+
+    /// Reference, error, force and commanded tensions at (t, y).
+    pub fn command(&self, t: f64, y: &[f64]) -> Command {
+        let (model_state, pid_state) = self.split(y);
+        let reference = self.trajectory.position(t);
+        let error = reference - self.model.effector(model_state).position.x;
+        let force = self.pid.force(error, pid_state);
+        let tensions = match &self.actuation {
+            Actuation::Pid => self.distribution.tensions(force),
+            Actuation::Prescribed(f) => f(t),
+        };
+        Command {
+            reference,
+            error,
+            force,
+            tensions,
+        }
+    }
+
+    /// Initial state by the rule of MODELS.md §2: the model's static equilibrium with the effector
+    /// at x_ref(0) and F0 unknown, velocities zero, w(0) = F0/I, f(0) = e(0) = 0, audits zero.
+    /// Without integral action (I = 0) no controller state holds F0; w(0) = 0 then.
+    pub fn initial_state(&mut self) -> Result<(Vec<f64>, Equilibrium), ModelError> {
+        let x0 = self.trajectory.position(0.0);
+        let eq = self.model.equilibrium(x0, self.distribution.tension_sum)?;
+        let pid = self.pid.state_holding(eq.force).unwrap_or_default();
+        let mut y = eq.state.clone();
+        y.extend_from_slice(&[pid.integral, pid.filter, 0.0, 0.0]);
+        Ok((y, eq))
+    }
+}
+
+impl<M: CableModel> OdeSystem for ClosedLoop<M> {
+    fn dimension(&self) -> usize {
+        self.model_len() + EXTRA_STATES
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        let n = self.model_len();
+        let cmd = self.command(t, y);
+        let (_, pid_state) = self.split(y);
+        let (model_state, tail) = y.split_at(n);
+        let (model_rate, tail_rate) = dy.split_at_mut(n);
+        self.model.rhs(t, model_state, cmd.tensions, model_rate);
+        let pid_rate = self.pid.state_rate(cmd.error, pid_state);
+        let reel = self.model.reel_speeds(model_state);
+        tail_rate[0] = pid_rate.integral;
+        tail_rate[1] = pid_rate.filter;
+        tail_rate[2] = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
+        tail_rate[3] = self.model.dissipation(model_state);
+        let _ = tail;
+    }
+}
+
+/// Why a run stopped early.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RunError {
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error("integrator failed at t = {t} s: {source}")]
+    Integrator {
+        t: f64,
+        #[source]
+        source: IntegratorError,
+    },
+    /// A commanded tension ≤ 0 (MODELS.md §2): a cable cannot push.
+    #[error("cable {cable} went slack at t = {t} s: commanded tension {tension} N ≤ 0")]
+    SlackCable { t: f64, cable: usize, tension: f64 },
+    #[error("integrator `{0}` is not available yet (only dopri5)")]
+    Unsupported(&'static str),
+}
+
+/// Output of a run: sampled channels, counters, the initial equilibrium, the state at the end.
+#[derive(Debug, Clone)]
+pub struct Run {
+    pub model: &'static str,
+    pub series: TimeSeries,
+    pub stats: SolverStats,
+    pub equilibrium: Equilibrium,
+    /// Closed-loop state at the last accepted step (model | w | f | W | D).
+    pub final_state: Vec<f64>,
+    /// Time reached [s] (t_final unless the run failed).
+    pub t_reached: f64,
+    /// Wall-clock time of the integration [s] (the only non-reproducible number of a run).
+    pub wall_s: f64,
+}
+
+/// A failed run: the reason and everything sampled before it.
+#[derive(Debug, Clone)]
+pub struct RunFailure {
+    pub error: RunError,
+    pub partial: Option<Run>,
+}
+
+impl std::fmt::Display for RunFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.error)?;
+        if let Some(run) = &self.partial {
+            write!(
+                f,
+                " (output kept up to t = {} s, {} samples)",
+                run.t_reached,
+                run.series.len()
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for RunFailure {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        Some(&self.error)
+    }
+}
+
+/// How to integrate and sample a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunOptions {
+    pub t_final: f64,
+    pub sample_period: f64,
+    pub integrator: IntegratorKind,
+    pub dopri: Dopri5Options,
+}
+
+impl From<&Scenario> for RunOptions {
+    fn from(s: &Scenario) -> Self {
+        let sim = &s.simulation;
+        Self {
+            t_final: sim.t_final,
+            sample_period: sim.sample_period,
+            integrator: sim.integrator,
+            dopri: Dopri5Options {
+                rtol: sim.rtol,
+                atol: sim.atol,
+                beta: sim.dopri_beta,
+                ..Dopri5Options::default()
+            },
+        }
+    }
+}
+
+/// Names of the channels every run has, in order, before the model's own.
+pub const COMMON_CHANNELS: [&str; 8] = ["t", "x_ref", "x", "z", "error", "F", "T1", "T2"];
+/// Energy channels every run has, after the model's own [J].
+pub const ENERGY_CHANNELS: [&str; 6] = [
+    "e_kinetic",
+    "e_elastic",
+    "e_gravity",
+    "w_reel",
+    "e_dissipated",
+    "e_residual",
+];
+
+/// Integrates the loop from its MODELS.md §2 initial state to `t_final`, sampling every
+/// `sample_period` on the dense output. `progress` receives the fraction of time done after each
+/// accepted step.
+pub fn simulate<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Run, Box<RunFailure>> {
+    let (y0, equilibrium) = sys.initial_state().map_err(|e| {
+        Box::new(RunFailure {
+            error: e.into(),
+            partial: None,
+        })
+    })?;
+    simulate_from(sys, y0, equilibrium, opts, progress)
+}
+
+/// As [`simulate`], from a given closed-loop state `y0` at t = 0 (`equilibrium` is reported as the
+/// run's starting point).
+pub fn simulate_from<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+    y0: Vec<f64>,
+    equilibrium: Equilibrium,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Run, Box<RunFailure>> {
+    let start = Instant::now();
+    let n = sys.model_len();
+    let mut names: Vec<String> = COMMON_CHANNELS.iter().map(|s| s.to_string()).collect();
+    names.extend(sys.model.channel_names());
+    names.extend(ENERGY_CHANNELS.iter().map(|s| s.to_string()));
+    let samples = (opts.t_final / opts.sample_period).round() as usize + 1;
+    let mut sampler = Sampler {
+        series: TimeSeries::with_capacity(names, samples),
+        row: Vec::new(),
+        y: vec![0.0; y0.len()],
+        model_channels: vec![0.0; sys.model.channel_names().len()],
+        energy0: sys.model.energy(&y0[..n]).total(),
+        next: 0,
+        samples,
+        period: opts.sample_period,
+    };
+    let mut run = Run {
+        model: sys.model.name(),
+        series: TimeSeries::with_capacity(Vec::new(), 0),
+        stats: SolverStats::default(),
+        equilibrium,
+        final_state: y0.clone(),
+        t_reached: 0.0,
+        wall_s: 0.0,
+    };
+    let fail =
+        |error: RunError, mut run: Run, sampler: Sampler, stats: SolverStats, y: &[f64], t: f64| {
+            run.series = sampler.series;
+            run.stats = stats;
+            run.final_state = y.to_vec();
+            run.t_reached = t;
+            run.wall_s = start.elapsed().as_secs_f64();
+            Box::new(RunFailure {
+                error,
+                partial: Some(run),
+            })
+        };
+    if opts.integrator != IntegratorKind::Dopri5 {
+        return Err(fail(
+            RunError::Unsupported("implicit"),
+            run,
+            sampler,
+            SolverStats::default(),
+            &y0,
+            0.0,
+        ));
+    }
+    let mut dopri = Dopri5::new(
+        y0.len(),
+        Dopri5Options {
+            norm_components: Some(n + 2),
+            ..opts.dopri
+        },
+    );
+    let t_end = opts.t_final;
+    if let Err(source) = dopri.start(sys, 0.0, &y0, t_end) {
+        return Err(fail(
+            RunError::Integrator { t: 0.0, source },
+            run,
+            sampler,
+            dopri.stats(),
+            &y0,
+            0.0,
+        ));
+    }
+    if let Err(e) = sampler.sample_through(sys, &dopri, 0.0) {
+        return Err(fail(e, run, sampler, dopri.stats(), &y0, 0.0));
+    }
+    while dopri.time() < t_end {
+        if let Err(source) = dopri.step(sys, t_end) {
+            let t = dopri.time();
+            let y = dopri.state().to_vec();
+            return Err(fail(
+                RunError::Integrator { t, source },
+                run,
+                sampler,
+                dopri.stats(),
+                &y,
+                t,
+            ));
+        }
+        let t = dopri.time();
+        let checked = sampler
+            .sample_through(sys, &dopri, t)
+            .and_then(|()| check_slack(t, sys.command(t, dopri.state()).tensions));
+        if let Err(e) = checked {
+            let y = dopri.state().to_vec();
+            return Err(fail(e, run, sampler, dopri.stats(), &y, t));
+        }
+        progress(t / t_end);
+    }
+    run.series = sampler.series;
+    run.stats = dopri.stats();
+    run.final_state = dopri.state().to_vec();
+    run.t_reached = dopri.time();
+    run.wall_s = start.elapsed().as_secs_f64();
+    Ok(run)
+}
+
+fn check_slack(t: f64, tensions: [f64; 2]) -> Result<(), RunError> {
+    for (i, &tension) in tensions.iter().enumerate() {
+        if tension.is_nan() || tension <= 0.0 {
+            return Err(RunError::SlackCable {
+                t,
+                cable: i + 1,
+                tension,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Samples the dense output on the grid t_k = k·Δt (computed, not accumulated, so the grid is
+/// exact and reproducible).
+struct Sampler {
+    series: TimeSeries,
+    row: Vec<f64>,
+    y: Vec<f64>,
+    model_channels: Vec<f64>,
+    energy0: f64,
+    next: usize,
+    samples: usize,
+    period: f64,
+}
+
+impl Sampler {
+    /// Appends every grid sample with t_k ≤ `t` (the end of the last accepted step).
+    fn sample_through<M: CableModel>(
+        &mut self,
+        sys: &ClosedLoop<M>,
+        dopri: &Dopri5,
+        t: f64,
+    ) -> Result<(), RunError> {
+        let n = sys.model_len();
+        while self.next < self.samples {
+            let tk = self.next as f64 * self.period;
+            // The last sample is the end point itself (t_final may not be a multiple of Δt by ulps).
+            let tk = if self.next + 1 == self.samples {
+                tk.min(t)
+            } else {
+                tk
+            };
+            if tk > t {
+                break;
+            }
+            if tk == t {
+                self.y.copy_from_slice(dopri.state());
+            } else {
+                dopri.dense_output(tk, &mut self.y);
+            }
+            let y = &self.y;
+            let cmd = sys.command(tk, y);
+            check_slack(tk, cmd.tensions)?;
+            let eff = sys.model.effector(&y[..n]);
+            sys.model
+                .channels(&y[..n], cmd.tensions, &mut self.model_channels);
+            let energy = sys.model.energy(&y[..n]);
+            let (work, dissipated) = (y[n + 2], y[n + 3]);
+            self.row.clear();
+            self.row.extend_from_slice(&[
+                tk,
+                cmd.reference,
+                eff.position.x,
+                eff.position.y,
+                cmd.error,
+                cmd.force,
+                cmd.tensions[0],
+                cmd.tensions[1],
+            ]);
+            self.row.extend_from_slice(&self.model_channels);
+            self.row.extend_from_slice(&[
+                energy.kinetic,
+                energy.elastic,
+                energy.gravity,
+                work,
+                dissipated,
+                energy.total() - self.energy0 - work + dissipated,
+            ]);
+            self.series.push_row(&self.row);
+            self.next += 1;
+        }
+        Ok(())
+    }
+}

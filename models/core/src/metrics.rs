@@ -1,0 +1,215 @@
+//! The metrics of MODELS.md §7 computed from a run's samples: the numbers the paper reports
+//! (tension extremes and settling, error, overshoot, z oscillation, spectral peaks) and the cost.
+//!
+//! Windows are the paper's: the transition [t1, t2], "after 1 s" = [1 s, t_final], the settled
+//! means over the last second [t_final − 1, t_final] (= [4, 5] s for the paper), spectra over
+//! [1 s, t_final) and the whole record [0, t_final].
+
+use crate::closed_loop::Run;
+use crate::spectrum::{Peak, Spectrum, Window};
+use crate::trajectory::Step5;
+
+/// Start of the settled window of the paper ("after 1 s") [s].
+pub const SETTLED_FROM: f64 = 1.0;
+/// Start of the strict settled window of MODELS.md §8 [s].
+pub const STRICT_SETTLED_FROM: f64 = 1.5;
+/// The high-frequency search starts above the physics of the effector (MODELS.md §7) [rad/s].
+pub const HF_FROM: f64 = 100.0;
+/// Refined peaks ignore the drift below this frequency [rad/s].
+pub const REFINED_FROM: f64 = 2.0;
+/// Zero-padding factor of the refined spectrum.
+pub const PAD: usize = 16;
+
+/// MODELS.md §7 metrics of one run. Keys are those of `metrics.json`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Metrics {
+    pub model: String,
+    /// Minimum of the commanded T1 [N] and when [s].
+    pub t1_min: f64,
+    pub t1_min_time: f64,
+    pub t1_max: f64,
+    pub t1_max_time: f64,
+    pub t2_min: f64,
+    pub t2_min_time: f64,
+    pub t2_max: f64,
+    pub t2_max_time: f64,
+    /// Commanded tensions at t_final [N].
+    pub t1_final: f64,
+    pub t2_final: f64,
+    /// Means of the commanded tensions over the last second [N].
+    pub t1_mean_4_5: f64,
+    pub t2_mean_4_5: f64,
+    /// max |x_ref − x| over [t1, t2] [m].
+    pub err_max_transition: f64,
+    /// max |x_ref − x| over [1 s, t_final] [m].
+    pub err_max_after_1s: f64,
+    /// max |x_ref − x| over [1.5 s, t_final] [m].
+    pub err_max_after_1_5s: f64,
+    /// max over the run of (x − x2)·sign(x2 − x1) [m] (negative: no overshoot).
+    pub overshoot: f64,
+    /// Mean and peak-to-peak of z over [1 s, t_final] [m].
+    pub z_mean: f64,
+    pub z_p2p: f64,
+    /// Refined spectral peaks (Hann, 16× padding, ω ≥ 2 rad/s) of z and of the error over
+    /// [1 s, t_final) [rad/s].
+    pub z_peak_rad_s: f64,
+    pub err_peak_rad_s: f64,
+    /// Plain FFT peaks (rectangular window, no padding) over [1 s, t_final) [rad/s].
+    pub z_plain_peak_rad_s: f64,
+    pub err_plain_peak_rad_s: f64,
+    /// Plain FFT peak of z over the whole record [0, t_final] [rad/s] and its bin index.
+    pub z_fft_0_5_bin_rad_s: f64,
+    pub z_fft_0_5_bin: usize,
+    /// Largest local maximum of the refined error spectrum above 100 rad/s [rad/s] and its level
+    /// relative to the main error peak [dB].
+    pub err_hf_peak_rad_s: f64,
+    pub err_hf_peak_db: f64,
+    /// Effector z and PID force at the initial equilibrium [m, N].
+    pub z0: f64,
+    pub f0: f64,
+    /// Largest |E − E0 − W + D| over the run [J] (energy balance residual).
+    pub energy_residual_max: f64,
+    /// Integrator cost.
+    pub rhs_evals: u64,
+    pub steps_accepted: u64,
+    pub steps_rejected: u64,
+    pub wall_s: f64,
+}
+
+/// Index range of the samples with t in [a, b] (`include_end`) or [a, b), on a grid of period dt.
+fn window(t: &[f64], a: f64, b: f64, include_end: bool, dt: f64) -> std::ops::Range<usize> {
+    let half = 0.5 * dt;
+    let start = t.partition_point(|&v| v < a - half);
+    let end = if include_end {
+        t.partition_point(|&v| v <= b + half)
+    } else {
+        t.partition_point(|&v| v < b - half)
+    };
+    start..end.max(start)
+}
+
+fn extreme(t: &[f64], v: &[f64], better: impl Fn(f64, f64) -> bool) -> (f64, f64) {
+    let mut best = (f64::NAN, f64::NAN);
+    for (&ti, &vi) in t.iter().zip(v) {
+        if best.1.is_nan() || better(vi, best.1) {
+            best = (ti, vi);
+        }
+    }
+    best
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+fn mean(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+fn peak_omega(p: Option<Peak>) -> f64 {
+    p.map_or(f64::NAN, |p| p.omega)
+}
+
+/// Spectra of one signal over the settled window.
+pub struct SettledSpectra {
+    pub plain: Spectrum,
+    pub refined: Spectrum,
+}
+
+impl SettledSpectra {
+    pub fn new(signal: &[f64], dt: f64) -> Self {
+        Self {
+            plain: Spectrum::new(signal, dt, Window::Rectangular, 1),
+            refined: Spectrum::new(signal, dt, Window::Hann, PAD),
+        }
+    }
+}
+
+impl Metrics {
+    /// Computes every metric of `run` sampled every `dt` [s] on the trajectory `step5`.
+    pub fn from_run(run: &Run, step5: &Step5, dt: f64) -> Self {
+        let s = &run.series;
+        let col = |name: &str| s.column(name).unwrap_or_default();
+        let (t, x, z, err, t1, t2) = (
+            col("t"),
+            col("x"),
+            col("z"),
+            col("error"),
+            col("T1"),
+            col("T2"),
+        );
+        let t_end = t.last().copied().unwrap_or(0.0);
+
+        let (t1_min_time, t1_min) = extreme(&t, &t1, |a, b| a < b);
+        let (t1_max_time, t1_max) = extreme(&t, &t1, |a, b| a > b);
+        let (t2_min_time, t2_min) = extreme(&t, &t2, |a, b| a < b);
+        let (t2_max_time, t2_max) = extreme(&t, &t2, |a, b| a > b);
+        let last = window(&t, t_end - 1.0, t_end, true, dt);
+        let transition = window(&t, step5.t1, step5.t2, true, dt);
+        let settled = window(&t, SETTLED_FROM, t_end, true, dt);
+        let strict = window(&t, STRICT_SETTLED_FROM, t_end, true, dt);
+        let spectral = window(&t, SETTLED_FROM, t_end, false, dt);
+
+        let direction = (step5.x2 - step5.x1).signum();
+        let overshoot = x
+            .iter()
+            .fold(f64::NEG_INFINITY, |m, &v| m.max((v - step5.x2) * direction));
+        let zs = &z[settled.clone()];
+        let z_p2p = zs.iter().fold(f64::NEG_INFINITY, |m, &v| m.max(v))
+            - zs.iter().fold(f64::INFINITY, |m, &v| m.min(v));
+
+        let z_spec = SettledSpectra::new(&z[spectral.clone()], dt);
+        let err_spec = SettledSpectra::new(&err[spectral.clone()], dt);
+        let whole = Spectrum::new(&z, dt, Window::Rectangular, 1).max_bin(0.0);
+        let err_main = err_spec.refined.refined_peak(REFINED_FROM);
+        let err_hf = err_spec.refined.largest_local_max_above(HF_FROM);
+        let err_hf_peak_db = match (err_hf, err_main) {
+            (Some(hf), Some(main)) => 20.0 * (hf.amplitude / main.amplitude).log10(),
+            _ => f64::NAN,
+        };
+        let energy_residual_max = max_abs(&col("e_residual"));
+
+        Self {
+            model: run.model.to_owned(),
+            t1_min,
+            t1_min_time,
+            t1_max,
+            t1_max_time,
+            t2_min,
+            t2_min_time,
+            t2_max,
+            t2_max_time,
+            t1_final: t1.last().copied().unwrap_or(f64::NAN),
+            t2_final: t2.last().copied().unwrap_or(f64::NAN),
+            t1_mean_4_5: mean(&t1[last.clone()]),
+            t2_mean_4_5: mean(&t2[last]),
+            err_max_transition: max_abs(&err[transition]),
+            err_max_after_1s: max_abs(&err[settled.clone()]),
+            err_max_after_1_5s: max_abs(&err[strict]),
+            overshoot,
+            z_mean: mean(zs),
+            z_p2p,
+            z_peak_rad_s: peak_omega(z_spec.refined.refined_peak(REFINED_FROM)),
+            err_peak_rad_s: peak_omega(err_main),
+            z_plain_peak_rad_s: peak_omega(z_spec.plain.max_bin(0.0)),
+            err_plain_peak_rad_s: peak_omega(err_spec.plain.max_bin(0.0)),
+            z_fft_0_5_bin_rad_s: peak_omega(whole),
+            z_fft_0_5_bin: whole.map_or(0, |p| p.bin),
+            err_hf_peak_rad_s: peak_omega(err_hf),
+            err_hf_peak_db,
+            z0: z.first().copied().unwrap_or(f64::NAN),
+            f0: run.equilibrium.force,
+            energy_residual_max,
+            rhs_evals: run.stats.rhs_evals,
+            steps_accepted: run.stats.steps_accepted,
+            steps_rejected: run.stats.steps_rejected,
+            wall_s: run.wall_s,
+        }
+    }
+}

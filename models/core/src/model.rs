@@ -1,0 +1,105 @@
+//! The interface through which a cable model plugs into the closed loop.
+//!
+//! A model owns its physical state layout (effector and cable coordinates and velocities), computes
+//! its right-hand side for given commanded tensions, and reports the effector, its energy and the
+//! extra output channels it has. It knows nothing of the controller, the trajectory or the
+//! integrator; the closed loop ([`crate::closed_loop`]) knows nothing of cables.
+
+use nalgebra::Vector2;
+
+/// Why a model refused a state or could not find its equilibrium.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ModelError {
+    /// A parameter outside the model's domain (e.g. a modelled length too short for the trajectory).
+    #[error("model parameter `{name}` = {value} is out of range: allowed {allowed}")]
+    Parameter {
+        name: &'static str,
+        value: f64,
+        allowed: String,
+    },
+    /// The static equilibrium of MODELS.md §2 was not found.
+    #[error("static equilibrium not found: {0}")]
+    Equilibrium(#[from] crate::statics::NewtonError),
+    /// The state left the model's domain (e.g. a node ordering the pulley rule forbids).
+    #[error("invalid model state at t = {t} s: {why}")]
+    State { t: f64, why: String },
+}
+
+/// Position and velocity of the effector (the point mass C of the paper) [m, m/s].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Effector {
+    pub position: Vector2<f64>,
+    pub velocity: Vector2<f64>,
+}
+
+/// Energy terms of a state [J]; gravity's zero is at z = 0 (the pulleys' height).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Energy {
+    /// Kinetic energy of effector and cable.
+    pub kinetic: f64,
+    /// Elastic (strain) energy of the cable.
+    pub elastic: f64,
+    /// Gravitational potential energy.
+    pub gravity: f64,
+}
+
+impl Energy {
+    /// Mechanical energy: kinetic + elastic + gravity.
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.elastic + self.gravity
+    }
+}
+
+/// Static equilibrium of MODELS.md §2: effector x held at x_ref(0), the PID's force F0 an unknown.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Equilibrium {
+    /// The model's state at rest.
+    pub state: Vec<f64>,
+    /// Horizontal force F0 [N] the tension distribution must supply: T1 = (ΣT − F0)/2, T2 = (ΣT + F0)/2.
+    pub force: f64,
+    /// Newton iterations used.
+    pub iterations: usize,
+    /// Largest force residual at the solution [N].
+    pub residual: f64,
+}
+
+/// A cable model of the two-cable planar CDPR: state, right-hand side, energy and tensions.
+///
+/// The commanded tensions `[T1, T2]` act at the reels; how they reach the effector is the model's
+/// physics. Implementations must not allocate in [`CableModel::rhs`].
+pub trait CableModel {
+    /// Short name used in files and tables ("elastic", "lumped", "fe").
+    fn name(&self) -> &'static str;
+
+    /// Number of components of the model's state vector.
+    fn state_len(&self) -> usize;
+
+    /// Static equilibrium with the effector's x fixed at `effector_x` [m] and commanded tensions
+    /// T1 = (ΣT − F0)/2, T2 = (ΣT + F0)/2, F0 an unknown; all velocities zero (MODELS.md §2).
+    fn equilibrium(&mut self, effector_x: f64, tension_sum: f64)
+    -> Result<Equilibrium, ModelError>;
+
+    /// State derivative for the commanded tensions `[T1, T2]` [N] at time `t` [s].
+    fn rhs(&mut self, t: f64, state: &[f64], tensions: [f64; 2], rate: &mut [f64]);
+
+    /// The effector's position and velocity in `state`.
+    fn effector(&self, state: &[f64]) -> Effector;
+
+    /// Rate at which each reel takes in cable [m/s] (positive: reeling in). The reels' power is
+    /// Σ T_i v_reel,i, so that d/dt (kinetic + elastic + gravity) = Σ T_i v_reel,i − dissipation.
+    fn reel_speeds(&self, state: &[f64]) -> [f64; 2];
+
+    /// Energy terms of `state`.
+    fn energy(&self, state: &[f64]) -> Energy;
+
+    /// Power dissipated inside the model [W] (damping); 0 for conservative models.
+    fn dissipation(&self, _state: &[f64]) -> f64 {
+        0.0
+    }
+
+    /// Names of the model's own output channels (with units), after the common ones.
+    fn channel_names(&self) -> Vec<String>;
+
+    /// Values of [`CableModel::channel_names`] for `state` under the tensions `[T1, T2]`.
+    fn channels(&self, state: &[f64], tensions: [f64; 2], out: &mut [f64]);
+}

@@ -1,0 +1,564 @@
+//! The scenario of one run (MODELS.md §1, §9): TOML in, the paper's values as defaults.
+//!
+//! Every key is optional, so an empty file is the paper's scenario. Unknown keys, malformed TOML and
+//! values outside their physical range are typed errors that name the key, the value and the allowed
+//! range; nothing here panics on bad input.
+
+use serde::Deserialize;
+use std::fmt;
+use std::path::Path;
+
+/// Why a scenario was refused.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    #[error("cannot read scenario file {path}: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    /// Malformed TOML, an unknown key or a value of the wrong type (the message names the key).
+    #[error("invalid scenario file: {0}")]
+    Syntax(String),
+    /// A value outside its allowed range.
+    #[error("scenario key `{key}` = {value} is out of range: allowed {allowed}")]
+    OutOfRange {
+        key: &'static str,
+        value: String,
+        allowed: String,
+    },
+}
+
+fn out_of_range(
+    key: &'static str,
+    value: impl fmt::Display,
+    allowed: impl Into<String>,
+) -> ScenarioError {
+    ScenarioError::OutOfRange {
+        key,
+        value: value.to_string(),
+        allowed: allowed.into(),
+    }
+}
+
+/// Robot geometry and effector (MODELS.md §1).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Robot {
+    /// Distance d between the pulleys A1 = (0, 0) and A2 = (d, 0) [m] (paper: 1 m).
+    pub anchor_distance: f64,
+    /// Effector point mass M [kg] (derived from eq. 15: 1 kg).
+    pub effector_mass: f64,
+    /// Gravitational acceleration g [m/s²], acting along −z.
+    pub gravity: f64,
+}
+
+impl Default for Robot {
+    fn default() -> Self {
+        Self {
+            anchor_distance: 1.0,
+            effector_mass: 1.0,
+            gravity: 9.81,
+        }
+    }
+}
+
+/// Cable material (MODELS.md §1).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Cable {
+    /// Young's modulus E [Pa] (paper: 102 GPa).
+    pub youngs_modulus: f64,
+    /// Cross-section A [m²] (paper: 1.76e-6 m²).
+    pub area: f64,
+    /// Density ρ [kg/m³] (chosen: steel, 7850).
+    pub density: f64,
+    /// Unstrained length L0 of each modelled cable, free span plus stored part [m] (lumped and FE).
+    pub modelled_length: f64,
+    /// Kelvin–Voigt axial damping coefficient C [N s] (massive-cable models; 0 in the paper's run).
+    pub axial_damping: f64,
+}
+
+impl Default for Cable {
+    fn default() -> Self {
+        Self {
+            youngs_modulus: 102e9,
+            area: 1.76e-6,
+            density: 7850.0,
+            modelled_length: 1.0,
+            axial_damping: 0.0,
+        }
+    }
+}
+
+impl Cable {
+    /// Axial stiffness EA [N].
+    pub fn axial_stiffness(&self) -> f64 {
+        self.youngs_modulus * self.area
+    }
+    /// Mass per unstrained length μ = ρA [kg/m].
+    pub fn mass_per_length(&self) -> f64 {
+        self.density * self.area
+    }
+}
+
+/// Which cable model a run uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ModelKind {
+    /// Massless elastic springs (paper §2.1).
+    #[default]
+    Elastic,
+    /// Lumped mass-spring cable sliding over the pulley (paper §2.2).
+    Lumped,
+    /// Variable-length finite elements (paper §2.3).
+    Fe,
+}
+
+impl ModelKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Elastic => "elastic",
+            ModelKind::Lumped => "lumped",
+            ModelKind::Fe => "fe",
+        }
+    }
+}
+
+impl fmt::Display for ModelKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for ModelKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "elastic" => Ok(ModelKind::Elastic),
+            "lumped" => Ok(ModelKind::Lumped),
+            "fe" => Ok(ModelKind::Fe),
+            other => Err(format!(
+                "unknown model `{other}`: allowed elastic, lumped, fe"
+            )),
+        }
+    }
+}
+
+/// FE mass matrix variant (MODELS.md FE.1.5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum FeMass {
+    #[default]
+    Consistent,
+    Lumped,
+}
+
+/// FE stored-cable variant (MODELS.md FE.1.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum FeStored {
+    #[default]
+    Elastic,
+    Rigid,
+}
+
+/// Model selection and discretisation.
+#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct Model {
+    pub kind: ModelKind,
+    /// Elements per cable; absent = 40 (lumped) / 10 (FE); unused by the elastic model.
+    pub elements: Option<i64>,
+    pub fe_mass: FeMass,
+    pub fe_stored: FeStored,
+}
+
+impl Model {
+    /// Elements per cable after applying the per-model default (paper: 40 lumped, 10 FE).
+    pub fn elements(&self) -> usize {
+        match (self.elements, self.kind) {
+            (Some(n), _) => n as usize,
+            (None, ModelKind::Lumped) => 40,
+            (None, ModelKind::Fe) => 10,
+            (None, ModelKind::Elastic) => 0,
+        }
+    }
+}
+
+/// PID gains and tension distribution (MODELS.md §2).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Controller {
+    /// Proportional gain P [N/m].
+    pub p: f64,
+    /// Integral gain I [N/(m s)].
+    pub i: f64,
+    /// Derivative gain D [N s/m].
+    pub d: f64,
+    /// Derivative filter coefficient N_f [1/s].
+    pub filter: f64,
+    /// Pretension sum ΣT = T1 + T2 [N].
+    pub tension_sum: f64,
+    /// Optional lower saturation of the commanded tensions [N] (absent = off).
+    pub t_min: Option<f64>,
+    /// Optional upper saturation of the commanded tensions [N] (absent = off).
+    pub t_max: Option<f64>,
+}
+
+impl Default for Controller {
+    fn default() -> Self {
+        Self {
+            p: 1860.0,
+            i: 8700.0,
+            d: 100.0,
+            filter: 540.0,
+            tension_sum: 200.0,
+            t_min: None,
+            t_max: None,
+        }
+    }
+}
+
+/// Trajectory family; the paper uses only `step5` (eq. 13).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum TrajectoryKind {
+    #[default]
+    Step5,
+}
+
+/// Reference trajectory of the effector's x (paper §3.1).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Trajectory {
+    pub kind: TrajectoryKind,
+    /// Start position x1 [m].
+    pub x1: f64,
+    /// End position x2 [m].
+    pub x2: f64,
+    /// Start time t1 [s].
+    pub t1: f64,
+    /// End time t2 [s].
+    pub t2: f64,
+}
+
+impl Default for Trajectory {
+    fn default() -> Self {
+        Self {
+            kind: TrajectoryKind::Step5,
+            x1: 0.5,
+            x2: 0.6,
+            t1: 0.0,
+            t2: 0.2,
+        }
+    }
+}
+
+/// Time integrator family.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum IntegratorKind {
+    /// Dormand–Prince 5(4) with dense output (the paper's ode45).
+    #[default]
+    Dopri5,
+    /// Implicit path for the stiff cable models (MODELS.md §6).
+    Implicit,
+}
+
+/// Implicit method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+pub enum ImplicitMethod {
+    #[default]
+    #[serde(rename = "generalized-alpha")]
+    GeneralizedAlpha,
+}
+
+/// Integration settings (MODELS.md §1, §6).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Simulation {
+    /// Final time [s].
+    pub t_final: f64,
+    /// Relative tolerance of the error norm.
+    pub rtol: f64,
+    /// Absolute tolerance of the error norm (every state component).
+    pub atol: f64,
+    /// Output sample period [s], from the dense output.
+    pub sample_period: f64,
+    /// Step-size controller β (Hairer's PI stabilisation; 0 = scipy RK45).
+    pub dopri_beta: f64,
+    pub integrator: IntegratorKind,
+    pub implicit_method: ImplicitMethod,
+    /// Fixed step of the implicit method [s].
+    pub step: f64,
+    /// Spectral radius at infinity of generalized-α.
+    pub rho_inf: f64,
+}
+
+impl Default for Simulation {
+    fn default() -> Self {
+        Self {
+            t_final: 5.0,
+            rtol: 1e-5,
+            atol: 1e-9,
+            sample_period: 1e-5,
+            dopri_beta: 0.04,
+            integrator: IntegratorKind::Dopri5,
+            implicit_method: ImplicitMethod::GeneralizedAlpha,
+            step: 1e-4,
+            rho_inf: 0.9,
+        }
+    }
+}
+
+/// One run, validated. Construct with [`Scenario::from_toml_str`], [`Scenario::from_file`] or
+/// [`Scenario::paper`]; after changing fields by hand call [`Scenario::validate`].
+#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct Scenario {
+    pub robot: Robot,
+    pub cable: Cable,
+    pub model: Model,
+    pub controller: Controller,
+    pub trajectory: Trajectory,
+    pub simulation: Simulation,
+}
+
+/// Largest number of output samples accepted (memory guard: ~50 channels × 8 B each).
+pub const MAX_SAMPLES: f64 = 2.0e7;
+
+impl Scenario {
+    /// The paper's scenario (MODELS.md §1), with the elastic model.
+    pub fn paper() -> Self {
+        Self::default()
+    }
+
+    /// Parses and validates a scenario from TOML text.
+    pub fn from_toml_str(text: &str) -> Result<Self, ScenarioError> {
+        let scenario: Scenario = toml::from_str(text)
+            .map_err(|e| ScenarioError::Syntax(e.to_string().trim_end().to_owned()))?;
+        scenario.validate()?;
+        Ok(scenario)
+    }
+
+    /// Reads, parses and validates a scenario file.
+    pub fn from_file(path: &Path) -> Result<Self, ScenarioError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::from_toml_str(&text)
+    }
+
+    /// Checks every value against its physical range; the first violation is returned.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        let r = &self.robot;
+        positive("robot.anchor_distance", r.anchor_distance)?;
+        positive("robot.effector_mass", r.effector_mass)?;
+        non_negative("robot.gravity", r.gravity)?;
+
+        let c = &self.cable;
+        positive("cable.youngs_modulus", c.youngs_modulus)?;
+        positive("cable.area", c.area)?;
+        positive("cable.density", c.density)?;
+        positive("cable.modelled_length", c.modelled_length)?;
+        non_negative("cable.axial_damping", c.axial_damping)?;
+
+        if let Some(n) = self.model.elements
+            && !(1..=100_000).contains(&n)
+        {
+            return Err(out_of_range(
+                "model.elements",
+                n,
+                "an integer in [1, 100000]",
+            ));
+        }
+
+        let k = &self.controller;
+        non_negative("controller.p", k.p)?;
+        non_negative("controller.i", k.i)?;
+        non_negative("controller.d", k.d)?;
+        positive("controller.filter", k.filter)?;
+        positive("controller.tension_sum", k.tension_sum)?;
+        if let Some(t_min) = k.t_min {
+            finite("controller.t_min", t_min)?;
+            if t_min < 0.0 || t_min >= k.tension_sum {
+                return Err(out_of_range(
+                    "controller.t_min",
+                    t_min,
+                    format!("[0, tension_sum = {}) N", k.tension_sum),
+                ));
+            }
+        }
+        if let Some(t_max) = k.t_max {
+            finite("controller.t_max", t_max)?;
+            let lower = k.t_min.unwrap_or(0.0).max(0.0);
+            if t_max <= lower {
+                return Err(out_of_range(
+                    "controller.t_max",
+                    t_max,
+                    format!("> t_min = {lower} N (finite)"),
+                ));
+            }
+        }
+        if r.gravity > 0.0 && r.effector_mass * r.gravity >= k.tension_sum {
+            return Err(out_of_range(
+                "controller.tension_sum",
+                k.tension_sum,
+                format!(
+                    "> effector weight M g = {} N (the cables cannot hold the effector otherwise)",
+                    r.effector_mass * r.gravity
+                ),
+            ));
+        }
+
+        let t = &self.trajectory;
+        let d = r.anchor_distance;
+        for (key, x) in [("trajectory.x1", t.x1), ("trajectory.x2", t.x2)] {
+            finite(key, x)?;
+            if !(x > 0.0 && x < d) {
+                return Err(out_of_range(
+                    key,
+                    x,
+                    format!("(0, anchor_distance = {d}) m: the workspace between the pulleys"),
+                ));
+            }
+        }
+        finite("trajectory.t1", t.t1)?;
+        if t.t1 < 0.0 {
+            return Err(out_of_range("trajectory.t1", t.t1, "≥ 0 s"));
+        }
+        finite("trajectory.t2", t.t2)?;
+        if t.t2 <= t.t1 {
+            return Err(out_of_range(
+                "trajectory.t2",
+                t.t2,
+                format!("> t1 = {} s", t.t1),
+            ));
+        }
+
+        let s = &self.simulation;
+        positive("simulation.t_final", s.t_final)?;
+        finite("simulation.rtol", s.rtol)?;
+        if !(s.rtol >= 1e-14 && s.rtol <= 0.1) {
+            return Err(out_of_range("simulation.rtol", s.rtol, "[1e-14, 0.1]"));
+        }
+        positive("simulation.atol", s.atol)?;
+        positive("simulation.sample_period", s.sample_period)?;
+        if s.sample_period > s.t_final {
+            return Err(out_of_range(
+                "simulation.sample_period",
+                s.sample_period,
+                format!("(0, t_final = {}] s", s.t_final),
+            ));
+        }
+        if s.t_final / s.sample_period > MAX_SAMPLES {
+            return Err(out_of_range(
+                "simulation.sample_period",
+                s.sample_period,
+                format!(
+                    "≥ t_final / {MAX_SAMPLES:e} = {} s",
+                    s.t_final / MAX_SAMPLES
+                ),
+            ));
+        }
+        finite("simulation.dopri_beta", s.dopri_beta)?;
+        if !(0.0..=0.2).contains(&s.dopri_beta) {
+            return Err(out_of_range(
+                "simulation.dopri_beta",
+                s.dopri_beta,
+                "[0, 0.2]",
+            ));
+        }
+        positive("simulation.step", s.step)?;
+        finite("simulation.rho_inf", s.rho_inf)?;
+        if !(0.0..=1.0).contains(&s.rho_inf) {
+            return Err(out_of_range("simulation.rho_inf", s.rho_inf, "[0, 1]"));
+        }
+
+        self.validate_modelled_length()
+    }
+
+    /// MODELS.md §9: the massive-cable models need enough modelled cable for the whole trajectory.
+    fn validate_modelled_length(&self) -> Result<(), ScenarioError> {
+        let kind = self.model.kind;
+        if kind == ModelKind::Elastic {
+            return Ok(());
+        }
+        let r = &self.robot;
+        let c = &self.cable;
+        let t = &self.trajectory;
+        // Elastic-model sag at mid-span bounds the effector's depth well enough for a 5 % margin.
+        let sag = 0.5
+            * r.anchor_distance
+            * (r.effector_mass * r.gravity / self.controller.tension_sum)
+                .asin()
+                .tan();
+        let reach = t.x1.max(t.x2).max(r.anchor_distance - t.x1.min(t.x2));
+        let chord = reach.hypot(sag);
+        let stretch = 1.0 + self.controller.tension_sum / c.axial_stiffness();
+        let free = 1.05 * stretch * chord;
+        let l0 = c.modelled_length;
+        let n = self.model.elements().max(1) as f64;
+        let (needed, why) = match kind {
+            ModelKind::Lumped => (free + 2.0 * l0 / n, "two spare stored elements"),
+            _ => (free / 0.95, "a stored length ≥ 5 % of it"),
+        };
+        if l0 < needed {
+            return Err(out_of_range(
+                "cable.modelled_length",
+                l0,
+                format!(
+                    "≥ {needed:.6} m for this trajectory (1.05 × (1 + ΣT/EA) × longest chord {chord:.6} m, plus {why})"
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn finite(key: &'static str, v: f64) -> Result<(), ScenarioError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(out_of_range(key, v, "a finite number"))
+    }
+}
+
+fn positive(key: &'static str, v: f64) -> Result<(), ScenarioError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(out_of_range(key, v, "finite and > 0"))
+    }
+}
+
+fn non_negative(key: &'static str, v: f64) -> Result<(), ScenarioError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(out_of_range(key, v, "finite and ≥ 0"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn empty_file_is_the_paper() {
+        let s = Scenario::from_toml_str("").unwrap();
+        assert_eq!(s, Scenario::paper());
+        assert_eq!(s.cable.axial_stiffness(), 102e9 * 1.76e-6);
+        assert_eq!(s.model.kind.name(), "elastic");
+    }
+
+    #[test]
+    fn element_defaults_follow_the_model() {
+        let s = Scenario::from_toml_str("[model]\nkind = \"lumped\"").unwrap();
+        assert_eq!(s.model.elements(), 40);
+        let s = Scenario::from_toml_str("[model]\nkind = \"fe\"").unwrap();
+        assert_eq!(s.model.elements(), 10);
+    }
+}

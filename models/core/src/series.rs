@@ -1,0 +1,69 @@
+//! Sampled output channels of a run, stored row by row (one contiguous buffer, appended once per
+//! sample) and read by column for analysis.
+
+/// Named channels sampled on a common time grid; channel 0 is the time t [s].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimeSeries {
+    names: Vec<String>,
+    data: Vec<f64>,
+}
+
+impl TimeSeries {
+    /// An empty series with room for `rows` samples.
+    pub fn with_capacity(names: Vec<String>, rows: usize) -> Self {
+        let width = names.len();
+        Self {
+            names,
+            data: Vec::with_capacity(rows * width),
+        }
+    }
+
+    /// Channel names, in column order.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// Number of channels.
+    pub fn width(&self) -> usize {
+        self.names.len()
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.data.len().checked_div(self.width()).unwrap_or(0)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.data.is_empty()
+    }
+
+    /// Appends one sample; `row` has one value per channel.
+    pub fn push_row(&mut self, row: &[f64]) {
+        assert_eq!(row.len(), self.width(), "row width");
+        self.data.extend_from_slice(row);
+    }
+
+    /// Sample `i`, all channels.
+    pub fn row(&self, i: usize) -> &[f64] {
+        let w = self.width();
+        &self.data[i * w..(i + 1) * w]
+    }
+
+    /// Index of the channel called `name`.
+    pub fn index(&self, name: &str) -> Option<usize> {
+        self.names.iter().position(|n| n == name)
+    }
+
+    /// A copy of the channel called `name`, if there is one.
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let j = self.index(name)?;
+        Some(
+            self.data
+                .iter()
+                .skip(j)
+                .step_by(self.width())
+                .copied()
+                .collect(),
+        )
+    }
+}

@@ -1,0 +1,93 @@
+//! The `step5` reference trajectory of the paper (eq. 13): a quintic that goes from x1 to x2 between
+//! t1 and t2 with zero velocity and acceleration at both ends, so the controller sees no shock.
+
+use crate::scenario;
+
+/// Quintic `step5` (paper eq. 13), with its first two derivatives for analysis and plots.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Step5 {
+    /// Start position x1 [m].
+    pub x1: f64,
+    /// End position x2 [m].
+    pub x2: f64,
+    /// Start time t1 [s].
+    pub t1: f64,
+    /// End time t2 [s] (> t1).
+    pub t2: f64,
+}
+
+impl From<&scenario::Trajectory> for Step5 {
+    fn from(t: &scenario::Trajectory) -> Self {
+        Self {
+            x1: t.x1,
+            x2: t.x2,
+            t1: t.t1,
+            t2: t.t2,
+        }
+    }
+}
+
+impl Step5 {
+    /// Δ(t) = (t − t1)/(t2 − t1) clamped to [0, 1] (eq. 13 is constant outside [t1, t2)).
+    fn progress(&self, t: f64) -> f64 {
+        ((t - self.t1) / (self.t2 - self.t1)).clamp(0.0, 1.0)
+    }
+
+    /// Reference position x_ref(t) [m], eq. 13: x1 + a Δ³ (10 − 15Δ + 6Δ²), a = x2 − x1.
+    pub fn position(&self, t: f64) -> f64 {
+        if t >= self.t2 {
+            return self.x2;
+        }
+        let s = self.progress(t);
+        self.x1 + (self.x2 - self.x1) * s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
+    }
+
+    /// Reference velocity [m/s]: a 30 Δ² (1 − Δ)² / (t2 − t1).
+    pub fn velocity(&self, t: f64) -> f64 {
+        let s = self.progress(t);
+        let span = self.t2 - self.t1;
+        (self.x2 - self.x1) * 30.0 * s * s * (1.0 - s) * (1.0 - s) / span
+    }
+
+    /// Reference acceleration [m/s²]: a 60 Δ (1 − Δ)(1 − 2Δ) / (t2 − t1)².
+    pub fn acceleration(&self, t: f64) -> f64 {
+        let s = self.progress(t);
+        let span = self.t2 - self.t1;
+        (self.x2 - self.x1) * 60.0 * s * (1.0 - s) * (1.0 - 2.0 * s) / (span * span)
+    }
+
+    /// Largest speed, 15 Δx / (8 (t2 − t1)), reached at the midpoint (paper: 0.9375 m/s).
+    pub fn max_speed(&self) -> f64 {
+        15.0 * (self.x2 - self.x1).abs() / (8.0 * (self.t2 - self.t1))
+    }
+
+    /// Largest |acceleration|, 10 Δx / (√3 (t2 − t1)²) (paper: 14.434 m/s²).
+    pub fn max_acceleration(&self) -> f64 {
+        let span = self.t2 - self.t1;
+        10.0 * (self.x2 - self.x1).abs() / (3f64.sqrt() * span * span)
+    }
+
+    /// Times of the acceleration extremes, Δ = 1/2 ∓ √3/6 (paper: 0.0423 s and 0.1577 s).
+    pub fn max_acceleration_times(&self) -> [f64; 2] {
+        let span = self.t2 - self.t1;
+        let h = 3f64.sqrt() / 6.0;
+        [self.t1 + (0.5 - h) * span, self.t1 + (0.5 + h) * span]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paper_values() {
+        let s = Step5::from(&scenario::Trajectory::default());
+        // The paper quotes 0.9375 m/s and 14.434 m/s² at t = 0.0423 s and 0.1577 s.
+        assert!((s.max_speed() - 0.9375).abs() < 1e-12);
+        assert!((s.velocity(0.1) - 0.9375).abs() < 1e-12);
+        assert!((s.max_acceleration() - 14.434).abs() < 5e-4);
+        let [ta, tb] = s.max_acceleration_times();
+        assert!((ta - 0.0423).abs() < 5e-5 && (tb - 0.1577).abs() < 5e-5);
+        assert!((s.acceleration(ta) - s.max_acceleration()).abs() < 1e-9);
+    }
+}
