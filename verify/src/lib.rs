@@ -1,1 +1,102 @@
-//! placeholder
+//! # cdpr-verify: the crate that knows every model
+//!
+//! It dispatches a scenario to its cable model, linearises the closed loop at the end position,
+//! and holds the acceptance table of MODELS.md §8 (the paper's numbers, ours, the tolerance,
+//! pass/fail) that both the tests and the report use. Its `tests/` hold the reference cases.
+
+use cdpr_core::closed_loop::{ClosedLoop, Run, RunFailure, RunOptions, simulate as run_loop};
+use cdpr_core::integrate::OdeSystem;
+use cdpr_core::metrics::Metrics;
+use cdpr_core::modal::{self, Mode};
+use cdpr_core::model::{CableModel, ModelError};
+use cdpr_core::scenario::{ModelKind, Scenario};
+use cdpr_core::trajectory::Step5;
+use cdpr_elastic::{Elastic, eq15_frequency};
+
+pub mod acceptance;
+
+/// Why a scenario could not be simulated or analysed.
+#[derive(Debug, thiserror::Error)]
+pub enum SimulateError {
+    #[error("model `{0}` is not implemented yet (available: elastic)")]
+    ModelUnavailable(ModelKind),
+    #[error(transparent)]
+    Run(#[from] Box<RunFailure>),
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error("eigenvalue computation failed: {0:?}")]
+    Eigen(cdpr_core::modal::EvdError),
+    #[error("no oscillatory closed-loop mode found")]
+    NoMode,
+}
+
+/// A scenario's model, ready for the closed loop (the one place that matches on the model kind).
+pub enum AnyModel {
+    Elastic(Elastic),
+}
+
+impl AnyModel {
+    /// The model the scenario asks for, or why it cannot be had.
+    pub fn new(scenario: &Scenario) -> Result<Self, SimulateError> {
+        match scenario.model.kind {
+            ModelKind::Elastic => Ok(AnyModel::Elastic(Elastic::new(scenario))),
+            kind => Err(SimulateError::ModelUnavailable(kind)),
+        }
+    }
+}
+
+/// Simulates the scenario (MODELS.md §2 initial state, DOPRI5 run, samples every sample period).
+pub fn simulate(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Run, SimulateError> {
+    let opts = RunOptions::from(scenario);
+    match AnyModel::new(scenario)? {
+        AnyModel::Elastic(m) => Ok(run_loop(
+            &mut ClosedLoop::new(m, scenario),
+            &opts,
+            progress,
+        )?),
+    }
+}
+
+/// Metrics of a run of `scenario` (MODELS.md §7).
+pub fn metrics(scenario: &Scenario, run: &Run) -> Metrics {
+    Metrics::from_run(
+        run,
+        &Step5::from(&scenario.trajectory),
+        scenario.simulation.sample_period,
+    )
+}
+
+/// The closed-loop mode nearest eq. 15 at the static equilibrium at x2 (the effector's vertical
+/// mode), from the finite-difference Jacobian of model + PID + tension distribution.
+pub fn vertical_mode_at_end(scenario: &Scenario) -> Result<Mode, SimulateError> {
+    match AnyModel::new(scenario)? {
+        AnyModel::Elastic(m) => vertical_mode(ClosedLoop::new(m, scenario), scenario),
+    }
+}
+
+fn vertical_mode<M: CableModel>(
+    mut sys: ClosedLoop<M>,
+    scenario: &Scenario,
+) -> Result<Mode, SimulateError> {
+    let x2 = scenario.trajectory.x2;
+    let eq = sys.model.equilibrium(x2, scenario.controller.tension_sum)?;
+    let pid = sys.pid.state_holding(eq.force).unwrap_or_default();
+    let mut y = eq.state.clone();
+    y.extend_from_slice(&[pid.integral, pid.filter, 0.0, 0.0]);
+    debug_assert_eq!(y.len(), sys.dimension());
+    // After t2 the reference is constant: the loop is autonomous there.
+    let t = scenario.trajectory.t2 + 1.0;
+    let jac = modal::closed_loop_jacobian(&mut sys, t, &y);
+    let modes = modal::modes(&jac).map_err(SimulateError::Eigen)?;
+    modal::nearest_mode(&modes, eq15_at_end(scenario)).ok_or(SimulateError::NoMode)
+}
+
+/// Eq. 15 at x2 with T = ΣT/2 [rad/s] (paper: 20.41 rad/s).
+pub fn eq15_at_end(scenario: &Scenario) -> f64 {
+    eq15_frequency(
+        0.5 * scenario.controller.tension_sum,
+        scenario.robot.effector_mass,
+        scenario.trajectory.x2,
+        scenario.robot.anchor_distance,
+    )
+}

@@ -1,1 +1,72 @@
-fn main() {}
+//! `cargo xtask`: the cdpr-bench command line.
+//!
+//! - `simulate`: one scenario → `timeseries.csv` and `metrics.json`;
+//! - `report`: the paper scenario for every available model → `REPORT.md` and `metrics.json`.
+//!
+//! Errors are printed for a person and give a non-zero exit; a failed run keeps its output.
+
+mod output;
+mod report;
+mod simulate;
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "cargo xtask",
+    about = "cdpr-bench: cable-driven parallel robot benchmark"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run one scenario and write DIR/timeseries.csv and DIR/metrics.json.
+    Simulate {
+        /// Scenario file (TOML, MODELS.md §9); absent = the paper's scenario.
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// Cable model, overriding the scenario's [model] kind: elastic | lumped | fe.
+        #[arg(long)]
+        model: Option<String>,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Write every K-th sample to the CSV (metrics always use every sample).
+        #[arg(long, default_value_t = 1)]
+        every: usize,
+    },
+    /// Run the paper scenario with every available model and write the reproduction report.
+    Report {
+        /// Output directory.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Scenario file overriding the paper's (for quick checks).
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Simulate {
+            scenario,
+            model,
+            out,
+            every,
+        } => simulate::run(scenario.as_deref(), model.as_deref(), &out, every),
+        Command::Report { out, scenario } => report::run(scenario.as_deref(), &out),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

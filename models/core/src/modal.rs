@@ -6,6 +6,8 @@ use crate::integrate::OdeSystem;
 use crate::model::CableModel;
 use faer::Mat;
 
+pub use faer::linalg::evd::EvdError;
+
 /// A continuous-time eigenvalue λ = σ + iω [1/s].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Mode {
@@ -47,7 +49,7 @@ pub fn closed_loop_jacobian<M: CableModel>(sys: &mut ClosedLoop<M>, t: f64, y: &
 }
 
 /// Eigenvalues of `jac` with ω ≥ 0 (one of each conjugate pair), sorted by frequency.
-pub fn modes(jac: &Mat<f64>) -> Result<Vec<Mode>, faer::linalg::evd::EvdError> {
+pub fn modes(jac: &Mat<f64>) -> Result<Vec<Mode>, EvdError> {
     let mut modes: Vec<Mode> = jac
         .eigenvalues()?
         .into_iter()
