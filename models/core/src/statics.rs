@@ -58,6 +58,10 @@ pub enum NewtonError {
     Singular { iteration: usize },
     #[error("non-finite residual at iteration {iteration}")]
     NonFinite { iteration: usize },
+    #[error(
+        "no step along the Newton direction reduces the residual at iteration {iteration} (largest residual {residual:e} N)"
+    )]
+    LineSearch { iteration: usize, residual: f64 },
 }
 
 /// Result of a converged Newton solve.
@@ -68,12 +72,19 @@ pub struct NewtonReport {
     pub residual: f64,
 }
 
+/// Step halvings tried before the Newton direction is declared useless (2^-40 ≈ 1e-12).
+const MAX_HALVINGS: usize = 40;
+
+fn norm2(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
 fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
 /// Solves R(u) = 0 from the guess in `unknowns` (overwritten with the solution), with a central
-/// finite-difference Jacobian and a dense LU (faer). Central differences with step
+/// finite-difference Jacobian, a dense LU (faer) and a backtracking line search. Central differences with step
 /// ε^(1/3)·scale make the Jacobian accurate to ~1e-10 relative, far more than Newton needs; the
 /// solution's accuracy is set by the residual alone.
 pub fn solve<P: StaticProblem>(
@@ -89,6 +100,7 @@ pub fn solve<P: StaticProblem>(
     let mut rm = vec![0.0; n];
     let mut jac = Mat::<f64>::zeros(n, n);
     let mut rhs = Mat::<f64>::zeros(n, 1);
+    let mut trial = vec![0.0; n];
     let mut update = f64::INFINITY;
     let mut residual = f64::INFINITY;
     for iteration in 0..=opts.max_iterations {
@@ -125,11 +137,36 @@ pub fn solve<P: StaticProblem>(
         if (0..n).any(|i| !delta[(i, 0)].is_finite()) {
             return Err(NewtonError::Singular { iteration });
         }
+        // Backtracking: halve the step until the residual's 2-norm decreases (or is already below
+        // the tolerance, where round-off makes "decrease" meaningless). Near the solution the full
+        // step is always taken, so quadratic convergence and the solution are unchanged.
+        let norm = norm2(&r);
+        let mut lambda = 1.0;
+        let mut accepted = false;
+        for _ in 0..MAX_HALVINGS {
+            for i in 0..n {
+                trial[i] = unknowns[i] + lambda * delta[(i, 0)];
+            }
+            problem.residual(&trial, &mut rp);
+            let trial_norm = norm2(&rp);
+            if trial_norm.is_finite() && (trial_norm < norm || max_abs(&rp) < opts.residual_tol) {
+                accepted = true;
+                break;
+            }
+            lambda *= 0.5;
+        }
+        if !accepted {
+            return Err(NewtonError::LineSearch {
+                iteration,
+                residual,
+            });
+        }
         update = 0.0;
         for i in 0..n {
-            unknowns[i] += delta[(i, 0)];
+            let step = trial[i] - unknowns[i];
+            unknowns[i] = trial[i];
             if i < n_len {
-                update = update.max(delta[(i, 0)].abs());
+                update = update.max(step.abs());
             }
         }
         if n_len == 0 {

@@ -158,7 +158,11 @@ impl CableModel for Elastic {
                 allowed: format!("> M g = {} N", self.effector_mass * self.gravity),
             });
         }
-        let mut unknowns = [self.midspan_sag(tension_sum), 0.0];
+        // Small-sag start (string with tension ΣT/2 deflected by M g at x): within a few percent of
+        // the solution anywhere in the workspace, where the mid-span sag is not near the pulleys.
+        let sag = -self.effector_mass * self.gravity * effector_x * (d - effector_x)
+            / (0.5 * tension_sum * d);
+        let mut unknowns = [sag, 0.0];
         let mut problem = Eq14 {
             model: self,
             x: effector_x,

@@ -1,0 +1,144 @@
+//! Property tests of the elastic model against references it did not produce: the force balance
+//! written out independently, eq. 15 in the small-sag limit, and the first integral of MODELS.md §3.
+
+use cdpr_core::closed_loop::{Actuation, ClosedLoop, RunOptions, simulate_from};
+use cdpr_core::integrate::Dopri5Options;
+use cdpr_core::model::CableModel;
+use cdpr_core::scenario::{IntegratorKind, Scenario};
+use cdpr_elastic::{Elastic, eq15_frequency};
+use nalgebra::Vector2;
+use proptest::prelude::*;
+
+fn model(d: f64, mass: f64, g: f64) -> Elastic {
+    let mut s = Scenario::paper();
+    s.robot.anchor_distance = d;
+    s.robot.effector_mass = mass;
+    s.robot.gravity = g;
+    Elastic::new(&s)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// Eq. 14 holds at the Newton solution for any position and pretension: the force balance,
+    /// written here from eq. 2–3 directly, vanishes to 1e-7 N (the solver's stopping criterion;
+    /// the round-off floor is ~1e-13 N for forces of ~100 N).
+    #[test]
+    fn equilibrium_balances_forces(
+        d in 0.5f64..3.0,
+        frac in 0.05f64..0.95,
+        mass in 0.1f64..5.0,
+        margin in 1.2f64..20.0,
+    ) {
+        let g = 9.81;
+        let tension_sum = margin * mass * g;
+        let mut m = model(d, mass, g);
+        let x = frac * d;
+        let eq = m.equilibrium(x, tension_sum).unwrap();
+        let z = eq.state[1];
+        prop_assert!(z < 0.0, "the effector hangs below the pulleys");
+        let (t1, t2) = (0.5 * (tension_sum - eq.force), 0.5 * (tension_sum + eq.force));
+        let (l1, l2) = (x.hypot(z), (d - x).hypot(z));
+        let fx = t1 * (-x) / l1 + t2 * (d - x) / l2;
+        let fz = t1 * (-z) / l1 + t2 * (-z) / l2 - mass * g;
+        prop_assert!(fx.abs() < 1e-7 && fz.abs() < 1e-7, "residual ({fx:e}, {fz:e}) N");
+        // Symmetry: the mirrored position needs the mirrored force.
+        let mirror = m.equilibrium(d - x, tension_sum).unwrap();
+        prop_assert!((mirror.force + eq.force).abs() < 1e-9 * tension_sum);
+        prop_assert!((mirror.state[1] - z).abs() < 1e-12);
+    }
+
+    /// In the small-sag limit the geometric vertical frequency tends to eq. 15. With the sag angle
+    /// θ ≤ M g/(2 T) ≤ 5e-4 the two differ by O(θ²) ≤ 1e-6 relative; 1e-5 leaves room for the
+    /// O(θ²) tension difference T1 ≠ T2 off-centre.
+    #[test]
+    fn vertical_frequency_tends_to_eq15(
+        frac in 0.1f64..0.9,
+        mass in 0.1f64..3.0,
+        tension_sum in 50.0f64..500.0,
+        sag_ratio in 1e-6f64..1e-3,
+    ) {
+        let d = 1.0;
+        let g = sag_ratio * tension_sum / mass;
+        let mut m = model(d, mass, g);
+        let x = frac * d;
+        let eq = m.equilibrium(x, tension_sum).unwrap();
+        let tensions = [0.5 * (tension_sum - eq.force), 0.5 * (tension_sum + eq.force)];
+        let geometric = m.vertical_frequency(Vector2::new(x, eq.state[1]), tensions);
+        let eq15 = eq15_frequency(0.5 * tension_sum, mass, x, d);
+        prop_assert!((geometric / eq15 - 1.0).abs() < 1e-5, "{geometric} vs {eq15}");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// PID off, constant tensions: E = ½M|v|² + M g z + T1 l1 + T2 l2 is a first integral
+    /// (MODELS.md §3). Random tensions (the equilibrium set of a random position and pretension)
+    /// and random disturbed initial states, 1 s of motion at rtol 1e-10: the drift is bounded by
+    /// the integrator's global error, ~1e-10 relative of E ≈ ΣT·l ≈ 100 J; we allow 1e-7 J.
+    #[test]
+    fn energy_is_a_first_integral_with_constant_tensions(
+        frac in 0.3f64..0.7,
+        tension_sum in 50.0f64..400.0,
+        dx in -5e-3f64..5e-3,
+        dz in -5e-3f64..5e-3,
+        vx in -0.05f64..0.05,
+        vz in -0.05f64..0.05,
+    ) {
+        let scenario = Scenario::paper();
+        let mut m = Elastic::new(&scenario);
+        let x = frac * scenario.robot.anchor_distance;
+        let eq = m.equilibrium(x, tension_sum).unwrap();
+        let tensions = [0.5 * (tension_sum - eq.force), 0.5 * (tension_sum + eq.force)];
+        let mut sys = ClosedLoop::new(m, &scenario);
+        sys.actuation = Actuation::Prescribed(Box::new(move |_| tensions));
+        let y0 = vec![x + dx, eq.state[1] + dz, vx, vz, 0.0, 0.0, 0.0, 0.0];
+        let opts = RunOptions {
+            t_final: 1.0,
+            sample_period: 1e-3,
+            integrator: IntegratorKind::Dopri5,
+            dopri: Dopri5Options { rtol: 1e-10, atol: 1e-12, ..Dopri5Options::default() },
+        };
+        let run = simulate_from(&mut sys, y0, eq, &opts, &mut |_| {}).unwrap();
+        let s = &run.series;
+        let col = |n: &str| s.column(n).unwrap();
+        let (ek, eg, l1, l2, resid) = (col("e_kinetic"), col("e_gravity"), col("l1"), col("l2"), col("e_residual"));
+        let energy: Vec<f64> = (0..s.len())
+            .map(|i| ek[i] + eg[i] + tensions[0] * l1[i] + tensions[1] * l2[i])
+            .collect();
+        let drift = energy.iter().map(|e| (e - energy[0]).abs()).fold(0.0, f64::max);
+        prop_assert!(drift < 1e-7, "first integral drifted by {drift:e} J");
+        // The runner's own audit (reel work integrated alongside) says the same.
+        let audit = resid.iter().map(|r| r.abs()).fold(0.0, f64::max);
+        prop_assert!(audit < 1e-7, "energy audit residual {audit:e} J");
+        // And the motion was not trivial: the disturbance moved energy between its forms.
+        let swing = ek.iter().fold(0.0f64, |m, &v| m.max(v));
+        prop_assert!(swing > 0.0);
+    }
+}
+
+/// The model's reel speeds are the rates at which the strained lengths shrink: −dl_i/dt by
+/// central differences along a uniform motion, to 1e-8 m/s (difference step 1e-6 s, O(h²) error).
+#[test]
+fn reel_speeds_are_the_shortening_rates() {
+    let m = Elastic::new(&Scenario::paper());
+    let y = [0.37, -0.08, 0.4, -0.3];
+    let h = 1e-6;
+    let lengths = |t: f64| {
+        m.cables(Vector2::new(y[0] + y[2] * t, y[1] + y[3] * t))
+            .map(|(l, _)| l)
+    };
+    let (lp, lm) = (lengths(h), lengths(-h));
+    let v = m.reel_speeds(&y);
+    for i in 0..2 {
+        let rate = -(lp[i] - lm[i]) / (2.0 * h);
+        assert!(
+            (v[i] - rate).abs() < 1e-8,
+            "cable {}: {} vs {}",
+            i + 1,
+            v[i],
+            rate
+        );
+    }
+}

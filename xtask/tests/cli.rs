@@ -1,0 +1,119 @@
+//! The command line as a person uses it: files written, errors printed, exit codes.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn xtask() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_xtask"))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("cdpr-xtask-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn simulate_writes_timeseries_and_metrics() {
+    let dir = temp_dir("simulate");
+    let scenario = dir.join("short.toml");
+    std::fs::write(
+        &scenario,
+        "[simulation]\nt_final = 1.2\nsample_period = 1e-4\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let status = xtask()
+        .args(["simulate", "--scenario"])
+        .arg(&scenario)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap();
+    assert!(header.starts_with("t,x_ref,x,z,error,F,T1,T2,"), "{header}");
+    assert_eq!(lines.count(), 12001, "samples at 0, 1e-4, …, 1.2 s");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    for key in [
+        "t1_min",
+        "t1_max",
+        "t1_final",
+        "t2_final",
+        "t1_mean_4_5",
+        "t2_mean_4_5",
+        "err_max_transition",
+        "err_max_after_1s",
+        "overshoot",
+        "z_mean",
+        "z_p2p",
+        "z_peak_rad_s",
+        "err_peak_rad_s",
+        "z_fft_0_5_bin_rad_s",
+        "err_hf_peak_rad_s",
+        "err_hf_peak_db",
+        "rhs_evals",
+        "steps_accepted",
+        "steps_rejected",
+        "wall_s",
+    ] {
+        assert!(json.get(key).is_some(), "metrics.json lacks `{key}`");
+    }
+    // No temporary files are left behind by the atomic writes.
+    let leftovers: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with('.'))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_scenario_is_reported_with_key_and_range() {
+    let dir = temp_dir("bad");
+    let scenario = dir.join("bad.toml");
+    std::fs::write(&scenario, "[robot]\neffector_mass = -1.0\n").unwrap();
+    let output = xtask()
+        .args(["simulate", "--scenario"])
+        .arg(&scenario)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("robot.effector_mass") && stderr.contains("allowed"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn unknown_model_and_unimplemented_model_are_clear_errors() {
+    let dir = temp_dir("model");
+    for (model, expect) in [
+        ("rigid", "unknown model `rigid`"),
+        ("lumped", "not implemented"),
+    ] {
+        let output = xtask()
+            .args(["simulate", "--model", model, "--out"])
+            .arg(dir.join("out"))
+            .output()
+            .unwrap();
+        assert!(!output.status.success());
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.contains(expect), "{model}: {stderr}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
