@@ -78,6 +78,7 @@ impl<M: CableModel> ClosedLoop<M> {
     }
 
     /// Reference, error, force and commanded tensions at (t, y).
+    #[inline]
     pub fn command(&self, t: f64, y: &[f64]) -> Command {
         let (model_state, pid_state) = self.split(y);
         let reference = self.trajectory.position(t);
@@ -237,13 +238,24 @@ pub fn simulate<M: CableModel>(
     opts: &RunOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Run, Box<RunFailure>> {
+    simulate_reusing(sys, opts, Vec::new(), progress)
+}
+
+/// As [`simulate`], writing the samples into `buffer`'s memory (from [`TimeSeries::into_buffer`]
+/// of an earlier run): sweeps and benches then allocate their output once.
+pub fn simulate_reusing<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+    opts: &RunOptions,
+    buffer: Vec<f64>,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Run, Box<RunFailure>> {
     let (y0, equilibrium) = sys.initial_state().map_err(|e| {
         Box::new(RunFailure {
             error: e.into(),
             partial: None,
         })
     })?;
-    simulate_from(sys, y0, equilibrium, opts, progress)
+    integrate_and_sample(sys, y0, equilibrium, opts, buffer, progress)
 }
 
 /// As [`simulate`], from a given closed-loop state `y0` at t = 0 (`equilibrium` is reported as the
@@ -255,6 +267,17 @@ pub fn simulate_from<M: CableModel>(
     opts: &RunOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Run, Box<RunFailure>> {
+    integrate_and_sample(sys, y0, equilibrium, opts, Vec::new(), progress)
+}
+
+fn integrate_and_sample<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+    y0: Vec<f64>,
+    equilibrium: Equilibrium,
+    opts: &RunOptions,
+    buffer: Vec<f64>,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Run, Box<RunFailure>> {
     let start = Instant::now();
     let n = sys.model_len();
     let mut names: Vec<String> = COMMON_CHANNELS.iter().map(|s| s.to_string()).collect();
@@ -262,10 +285,9 @@ pub fn simulate_from<M: CableModel>(
     names.extend(ENERGY_CHANNELS.iter().map(|s| s.to_string()));
     let samples = (opts.t_final / opts.sample_period).round() as usize + 1;
     let mut sampler = Sampler {
-        series: TimeSeries::with_capacity(names, samples),
-        row: Vec::new(),
+        series: TimeSeries::with_buffer(names, samples, buffer),
         y: vec![0.0; y0.len()],
-        model_channels: vec![0.0; sys.model.channel_names().len()],
+        model_channels: sys.model.channel_names().len(),
         energy0: sys.model.energy(&y0[..n]).total(),
         next: 0,
         samples,
@@ -371,9 +393,9 @@ fn check_slack(t: f64, tensions: [f64; 2]) -> Result<(), RunError> {
 /// exact and reproducible).
 struct Sampler {
     series: TimeSeries,
-    row: Vec<f64>,
     y: Vec<f64>,
-    model_channels: Vec<f64>,
+    /// Number of the model's own channels.
+    model_channels: usize,
     energy0: f64,
     next: usize,
     samples: usize,
@@ -408,32 +430,35 @@ impl Sampler {
             let y = &self.y;
             let cmd = sys.command(tk, y);
             check_slack(tk, cmd.tensions)?;
-            let eff = sys.model.effector(&y[..n]);
-            sys.model
-                .channels(&y[..n], cmd.tensions, &mut self.model_channels);
-            let energy = sys.model.energy(&y[..n]);
+            let model_state = &y[..n];
+            let eff = sys.model.effector(model_state);
+            let energy = sys.model.energy(model_state);
             let (work, dissipated) = (y[n + 2], y[n + 3]);
-            self.row.clear();
-            self.row.extend_from_slice(&[
-                tk,
-                cmd.reference,
-                eff.position.x,
-                eff.position.y,
-                cmd.error,
-                cmd.force,
-                cmd.tensions[0],
-                cmd.tensions[1],
-            ]);
-            self.row.extend_from_slice(&self.model_channels);
-            self.row.extend_from_slice(&[
-                energy.kinetic,
-                energy.elastic,
-                energy.gravity,
-                work,
-                dissipated,
-                energy.total() - self.energy0 - work + dissipated,
-            ]);
-            self.series.push_row(&self.row);
+            let residual = energy.total() - self.energy0 - work + dissipated;
+            let m = self.model_channels;
+            self.series.push_row_with(|row| {
+                let (common, rest) = row.split_at_mut(COMMON_CHANNELS.len());
+                let (own, energies) = rest.split_at_mut(m);
+                common.copy_from_slice(&[
+                    tk,
+                    cmd.reference,
+                    eff.position.x,
+                    eff.position.y,
+                    cmd.error,
+                    cmd.force,
+                    cmd.tensions[0],
+                    cmd.tensions[1],
+                ]);
+                sys.model.channels(model_state, cmd.tensions, own);
+                energies.copy_from_slice(&[
+                    energy.kinetic,
+                    energy.elastic,
+                    energy.gravity,
+                    work,
+                    dissipated,
+                    residual,
+                ]);
+            });
             self.next += 1;
         }
         Ok(())

@@ -40,6 +40,7 @@ pub struct PidState {
 
 impl Pid {
     /// Force F = P e + I w + D N_f (e − f) [N] for the tracking error e = x_ref − x [m].
+    #[inline]
     pub fn force(&self, error: f64, state: PidState) -> f64 {
         self.p * error + self.i * state.integral + self.d * self.filter * (error - state.filter)
     }
@@ -89,6 +90,7 @@ impl From<&scenario::Controller> for TensionDistribution {
 
 impl TensionDistribution {
     /// Commanded tensions [T1, T2] [N] for the horizontal force F [N].
+    #[inline]
     pub fn tensions(&self, force: f64) -> [f64; 2] {
         let t1 = 0.5 * (self.tension_sum - force);
         let t2 = 0.5 * (self.tension_sum + force);

@@ -11,11 +11,24 @@ pub struct TimeSeries {
 impl TimeSeries {
     /// An empty series with room for `rows` samples.
     pub fn with_capacity(names: Vec<String>, rows: usize) -> Self {
-        let width = names.len();
+        Self::with_buffer(names, rows, Vec::new())
+    }
+
+    /// As [`TimeSeries::with_capacity`], reusing `buffer`'s memory (e.g. from
+    /// [`TimeSeries::into_buffer`] of a previous run): a sweep then allocates and faults in its
+    /// output memory once, not once per run.
+    pub fn with_buffer(names: Vec<String>, rows: usize, mut buffer: Vec<f64>) -> Self {
+        buffer.clear();
+        buffer.reserve(rows * names.len());
         Self {
             names,
-            data: Vec::with_capacity(rows * width),
+            data: buffer,
         }
+    }
+
+    /// The sample storage, for reuse by the next run.
+    pub fn into_buffer(self) -> Vec<f64> {
+        self.data
     }
 
     /// Channel names, in column order.
@@ -41,6 +54,13 @@ impl TimeSeries {
     pub fn push_row(&mut self, row: &[f64]) {
         assert_eq!(row.len(), self.width(), "row width");
         self.data.extend_from_slice(row);
+    }
+
+    /// Appends one sample written in place by `fill` (no intermediate row, no copy).
+    pub fn push_row_with(&mut self, fill: impl FnOnce(&mut [f64])) {
+        let start = self.data.len();
+        self.data.resize(start + self.width(), 0.0);
+        fill(&mut self.data[start..]);
     }
 
     /// Sample `i`, all channels.

@@ -111,7 +111,8 @@ impl Spectrum {
             self.amplitude[k + 1].ln(),
         );
         let denom = a - 2.0 * b + c;
-        if !(denom < 0.0) {
+        // A maximum has negative curvature; anything else (flat, NaN) is left unrefined.
+        if denom.is_nan() || denom >= 0.0 {
             return peak;
         }
         let delta = 0.5 * (a - c) / denom;

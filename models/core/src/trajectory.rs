@@ -34,6 +34,7 @@ impl Step5 {
     }
 
     /// Reference position x_ref(t) [m], eq. 13: x1 + a Δ³ (10 − 15Δ + 6Δ²), a = x2 − x1.
+    #[inline]
     pub fn position(&self, t: f64) -> f64 {
         if t >= self.t2 {
             return self.x2;

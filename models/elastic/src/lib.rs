@@ -210,19 +210,21 @@ impl CableModel for Elastic {
         }
     }
 
+    /// Strained lengths l_i and unstrained lengths l0_i (eq. 1) [m]. A massless cable carries the
+    /// commanded tension to the effector unchanged, so no separate effector-end tension is stored.
     fn channel_names(&self) -> Vec<String> {
-        ["l1", "l2", "l0_1", "l0_2", "T_effector_1", "T_effector_2"]
-            .map(String::from)
-            .to_vec()
+        ["l1", "l2", "l0_1", "l0_2"].map(String::from).to_vec()
     }
 
-    /// Strained lengths l_i [m], unstrained lengths l0_i (eq. 1) [m], and the tension at the
-    /// effector end [N] (equal to the commanded one for a massless cable).
     fn channels(&self, y: &[f64], tensions: [f64; 2], out: &mut [f64]) {
-        let c = Vector2::new(y[X], y[Z]);
-        let [(l1, _), (l2, _)] = self.cables(c);
-        let [l01, l02] = self.unstrained_lengths(c, tensions);
-        out.copy_from_slice(&[l1, l2, l01, l02, tensions[0], tensions[1]]);
+        let [(l1, _), (l2, _)] = self.cables(Vector2::new(y[X], y[Z]));
+        let ea = self.axial_stiffness;
+        out.copy_from_slice(&[
+            l1,
+            l2,
+            l1 / (1.0 + tensions[0] / ea),
+            l2 / (1.0 + tensions[1] / ea),
+        ]);
     }
 }
 

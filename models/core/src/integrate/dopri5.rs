@@ -292,13 +292,13 @@ impl Dopri5 {
             self.stats.rhs_evals += 6;
             if err.is_nan() {
                 // A NaN never passes the error test; shrinking is the only way out, but say where.
-                if let Some(component) = self.y1.iter().position(|v| !v.is_finite()) {
-                    if self.h.abs() <= self.t.abs().max(1.0) * 1e-14 {
-                        return Err(IntegratorError::NonFinite {
-                            t: self.t,
-                            component,
-                        });
-                    }
+                if let Some(component) = self.y1.iter().position(|v| !v.is_finite())
+                    && self.h.abs() <= self.t.abs().max(1.0) * 1e-14
+                {
+                    return Err(IntegratorError::NonFinite {
+                        t: self.t,
+                        component,
+                    });
                 }
                 self.h *= self.opts.min_factor;
                 reject = true;
@@ -410,7 +410,9 @@ impl Dopri5 {
         std::mem::swap(&mut self.y, &mut self.y1);
     }
 
-    /// Dense output (order 4) at t in [t_old, t] of the last accepted step, into `out`.
+    /// Dense output (order 4) at t in [t_old, t] of the last accepted step, into `out` (the first
+    /// `out.len()` components).
+    #[inline]
     pub fn dense_output(&self, t: f64, out: &mut [f64]) {
         let h = self.t - self.t_old;
         if h <= 0.0 {
@@ -421,8 +423,8 @@ impl Dopri5 {
         let theta = (t - self.t_old) / h;
         let theta1 = 1.0 - theta;
         let [c1, c2, c3, c4, c5] = &self.cont;
-        for i in 0..out.len() {
-            out[i] = c1[i] + theta * (c2[i] + theta1 * (c3[i] + theta * (c4[i] + theta1 * c5[i])));
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = c1[i] + theta * (c2[i] + theta1 * (c3[i] + theta * (c4[i] + theta1 * c5[i])));
         }
     }
 }
