@@ -24,6 +24,11 @@ struct ModelEntry<'a> {
     vertical_mode: Mode,
 }
 
+/// A Markdown table cell: `|` (as in "max |error|") would end the cell.
+fn cell(text: &str) -> String {
+    text.replace('|', "\\|")
+}
+
 pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     let base = load_scenario(scenario, None)?;
     std::fs::create_dir_all(out)?;
