@@ -92,11 +92,8 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
         writeln!(w, "|---|---|---|---|---|---|")?;
         for c in &checks {
             let mark = if c.pass { "✅" } else { "❌" };
-            writeln!(
-                w,
-                "| {} | {} | {} | {} | {} | {mark} |",
-                c.quantity, c.model, c.paper, c.ours, c.accept
-            )?;
+            let cells = [&c.quantity, &c.model, &c.paper, &c.ours, &c.accept].map(|s| cell(s));
+            writeln!(w, "| {} | {mark} |", cells.join(" | "))?;
         }
         writeln!(w, "\n## Solver statistics\n")?;
         writeln!(w, "| model | RHS evaluations | accepted | rejected |")?;
