@@ -12,13 +12,14 @@ use cdpr_core::model::{CableModel, ModelError};
 use cdpr_core::scenario::{ModelKind, Scenario};
 use cdpr_core::trajectory::Step5;
 use cdpr_elastic::{Elastic, eq15_frequency};
+use cdpr_lumped::Lumped;
 
 pub mod acceptance;
 
 /// Why a scenario could not be simulated or analysed.
 #[derive(Debug, thiserror::Error)]
 pub enum SimulateError {
-    #[error("model `{0}` is not implemented yet (available: elastic)")]
+    #[error("model `{0}` is not implemented yet (available: elastic, lumped)")]
     ModelUnavailable(ModelKind),
     #[error(transparent)]
     Run(#[from] Box<RunFailure>),
@@ -33,6 +34,7 @@ pub enum SimulateError {
 /// A scenario's model, ready for the closed loop (the one place that matches on the model kind).
 pub enum AnyModel {
     Elastic(Elastic),
+    Lumped(Lumped),
 }
 
 impl AnyModel {
@@ -40,6 +42,7 @@ impl AnyModel {
     pub fn new(scenario: &Scenario) -> Result<Self, SimulateError> {
         match scenario.model.kind {
             ModelKind::Elastic => Ok(AnyModel::Elastic(Elastic::new(scenario))),
+            ModelKind::Lumped => Ok(AnyModel::Lumped(Lumped::new(scenario)?)),
             kind => Err(SimulateError::ModelUnavailable(kind)),
         }
     }
@@ -50,6 +53,11 @@ pub fn simulate(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Ru
     let opts = RunOptions::from(scenario);
     match AnyModel::new(scenario)? {
         AnyModel::Elastic(m) => Ok(run_loop(
+            &mut ClosedLoop::new(m, scenario),
+            &opts,
+            progress,
+        )?),
+        AnyModel::Lumped(m) => Ok(run_loop(
             &mut ClosedLoop::new(m, scenario),
             &opts,
             progress,
@@ -71,6 +79,7 @@ pub fn metrics(scenario: &Scenario, run: &Run) -> Metrics {
 pub fn vertical_mode_at_end(scenario: &Scenario) -> Result<Mode, SimulateError> {
     match AnyModel::new(scenario)? {
         AnyModel::Elastic(m) => vertical_mode(ClosedLoop::new(m, scenario), scenario),
+        AnyModel::Lumped(m) => vertical_mode(ClosedLoop::new(m, scenario), scenario),
     }
 }
 

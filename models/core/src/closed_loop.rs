@@ -3,12 +3,12 @@
 //!
 //! State layout: `[model state (n) | w | f | W | D]`: the PID integral and filter states, then two
 //! audit states excluded from the error norm, the reels' work W = ∫ Σ T_i v_reel,i dt and the energy
-//! dissipated inside the model D. They make the energy balance E(t) − E(0) − W(t) + D(t) = 0 a
-//! channel of every run.
+//! dissipated inside the model D. They make the energy balance E(t) − E(0) − W(t) + D(t) − ΣΔE = 0
+//! (ΔE the energy changes of model events) a channel of every run.
 
 use crate::controller::{Pid, PidState, TensionDistribution};
 use crate::integrate::{Dopri5, Dopri5Options, IntegratorError, OdeSystem, SolverStats};
-use crate::model::{CableModel, Equilibrium, ModelError};
+use crate::model::{CableModel, Equilibrium, ModelError, ModelEvent};
 use crate::scenario::{IntegratorKind, Scenario};
 use crate::series::TimeSeries;
 use crate::trajectory::Step5;
@@ -160,6 +160,8 @@ pub struct Run {
     pub final_state: Vec<f64>,
     /// Time reached [s] (t_final unless the run failed).
     pub t_reached: f64,
+    /// Model events (e.g. lumped nodes passing a pulley), in time order.
+    pub events: Vec<ModelEvent>,
     /// Wall-clock time of the integration [s] (the only non-reproducible number of a run).
     pub wall_s: f64,
 }
@@ -289,41 +291,11 @@ fn integrate_and_sample<M: CableModel>(
         y: vec![0.0; y0.len()],
         model_channels: sys.model.channel_names().len(),
         energy0: sys.model.energy(&y0[..n]).total(),
+        event_energy: 0.0,
         next: 0,
         samples,
         period: opts.sample_period,
     };
-    let mut run = Run {
-        model: sys.model.name(),
-        series: TimeSeries::with_capacity(Vec::new(), 0),
-        stats: SolverStats::default(),
-        equilibrium,
-        final_state: y0.clone(),
-        t_reached: 0.0,
-        wall_s: 0.0,
-    };
-    let fail =
-        |error: RunError, mut run: Run, sampler: Sampler, stats: SolverStats, y: &[f64], t: f64| {
-            run.series = sampler.series;
-            run.stats = stats;
-            run.final_state = y.to_vec();
-            run.t_reached = t;
-            run.wall_s = start.elapsed().as_secs_f64();
-            Box::new(RunFailure {
-                error,
-                partial: Some(run),
-            })
-        };
-    if opts.integrator != IntegratorKind::Dopri5 {
-        return Err(fail(
-            RunError::Unsupported("implicit"),
-            run,
-            sampler,
-            SolverStats::default(),
-            &y0,
-            0.0,
-        ));
-    }
     let mut dopri = Dopri5::new(
         y0.len(),
         Dopri5Options {
@@ -331,62 +303,174 @@ fn integrate_and_sample<M: CableModel>(
             ..opts.dopri
         },
     );
-    let t_end = opts.t_final;
-    if let Err(source) = dopri.start(sys, 0.0, &y0, t_end) {
-        return Err(fail(
-            RunError::Integrator { t: 0.0, source },
-            run,
-            sampler,
-            dopri.stats(),
+    let mut events = Vec::new();
+    let outcome = if opts.integrator == IntegratorKind::Dopri5 {
+        integrate(
+            sys,
             &y0,
-            0.0,
-        ));
+            opts.t_final,
+            &mut dopri,
+            &mut sampler,
+            &mut events,
+            progress,
+        )
+    } else {
+        Err(RunError::Unsupported("implicit"))
+    };
+    let t_reached = if dopri.stats().rhs_evals == 0 {
+        0.0
+    } else {
+        dopri.time()
+    };
+    let run = Run {
+        model: sys.model.name(),
+        series: sampler.series,
+        stats: dopri.stats(),
+        equilibrium,
+        final_state: if t_reached > 0.0 {
+            dopri.state().to_vec()
+        } else {
+            y0
+        },
+        t_reached,
+        events,
+        wall_s: start.elapsed().as_secs_f64(),
+    };
+    match outcome {
+        Ok(()) => Ok(run),
+        Err(error) => Err(Box::new(RunFailure {
+            error,
+            partial: Some(run),
+        })),
     }
-    if let Err(e) = sampler.sample_through(sys, &dopri, 0.0) {
-        return Err(fail(e, run, sampler, dopri.stats(), &y0, 0.0));
-    }
-    while dopri.time() < t_end {
-        if let Err(source) = dopri.step(sys, t_end) {
-            let t = dopri.time();
-            let y = dopri.state().to_vec();
-            return Err(fail(
-                RunError::Integrator { t, source },
-                run,
-                sampler,
-                dopri.stats(),
-                &y,
-                t,
-            ));
-        }
-        let t = dopri.time();
-        let checked = sampler
-            .sample_through(sys, &dopri, t)
-            .and_then(|()| check_slack(t, sys.command(t, dopri.state()).tensions));
-        if let Err(e) = checked {
-            let y = dopri.state().to_vec();
-            return Err(fail(e, run, sampler, dopri.stats(), &y, t));
-        }
-        progress(t / t_end);
-    }
-    run.series = sampler.series;
-    run.stats = dopri.stats();
-    run.final_state = dopri.state().to_vec();
-    run.t_reached = dopri.time();
-    run.wall_s = start.elapsed().as_secs_f64();
-    Ok(run)
 }
 
-fn check_slack(t: f64, tensions: [f64; 2]) -> Result<(), RunError> {
-    for (i, &tension) in tensions.iter().enumerate() {
-        if tension.is_nan() || tension <= 0.0 {
-            return Err(RunError::SlackCable {
-                t,
-                cable: i + 1,
-                tension,
-            });
-        }
+/// The integration loop: accepted steps, located model events, samples, slack checks.
+fn integrate<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+    y0: &[f64],
+    t_end: f64,
+    dopri: &mut Dopri5,
+    sampler: &mut Sampler,
+    events: &mut Vec<ModelEvent>,
+    progress: &mut dyn FnMut(f64),
+) -> Result<(), RunError> {
+    let integrator = |t: f64| move |source| RunError::Integrator { t, source };
+    dopri.start(sys, 0.0, y0, t_end).map_err(integrator(0.0))?;
+    let mut monitor = EventMonitor::new(sys, y0);
+    sampler.sample_through(sys, dopri, 0.0)?;
+    while dopri.time() < t_end {
+        dopri.step(sys, t_end).map_err(integrator(dopri.time()))?;
+        let Some((index, t_event)) = monitor.earliest_crossing(sys, dopri) else {
+            let t = dopri.time();
+            sampler.sample_through(sys, dopri, t)?;
+            check_slack(t, sys.command(t, dopri.state()).tensions)?;
+            monitor.accept(sys, dopri.state());
+            progress(t / t_end);
+            continue;
+        };
+        // Samples up to the event come from the step as integrated; the event changes the state
+        // there and the integrator restarts from it, abandoning the rest of the step.
+        sampler.sample_through(sys, dopri, t_event)?;
+        let mut y = vec![0.0; y0.len()];
+        dopri.dense_output(t_event, &mut y);
+        let n = sys.model_len();
+        let event = sys.model.apply_event(index, t_event, &mut y[..n])?;
+        sampler.event_energy += event.energy_change;
+        events.push(event);
+        dopri.restart(sys, t_event, &y);
+        check_slack(t_event, sys.command(t_event, &y).tensions)?;
+        monitor.accept(sys, &y);
     }
     Ok(())
+}
+
+/// Watches the model's event functions between accepted steps and locates sign changes on the
+/// dense output by bisection to [`EVENT_TIME_TOL`] (MODELS.md §4).
+struct EventMonitor {
+    /// g at the start of the current step.
+    before: Vec<f64>,
+    after: Vec<f64>,
+    probe: Vec<f64>,
+    y: Vec<f64>,
+}
+
+/// Width of the bracket a located event time lies in [s].
+pub const EVENT_TIME_TOL: f64 = 1e-12;
+
+impl EventMonitor {
+    fn new<M: CableModel>(sys: &ClosedLoop<M>, y: &[f64]) -> Self {
+        let k = sys.model.event_count();
+        let mut monitor = Self {
+            before: vec![0.0; k],
+            after: vec![0.0; k],
+            probe: vec![0.0; k],
+            y: vec![0.0; if k > 0 { y.len() } else { 0 }],
+        };
+        monitor.accept(sys, y);
+        monitor
+    }
+
+    /// Takes `y` as the start of the next step.
+    fn accept<M: CableModel>(&mut self, sys: &ClosedLoop<M>, y: &[f64]) {
+        if !self.before.is_empty() {
+            sys.model
+                .event_functions(&y[..sys.model_len()], &mut self.before);
+        }
+    }
+
+    /// The earliest event function that fell from > 0 to ≤ 0 over the last accepted step, with
+    /// the first time at which it is ≤ 0 (to within [`EVENT_TIME_TOL`]).
+    fn earliest_crossing<M: CableModel>(
+        &mut self,
+        sys: &ClosedLoop<M>,
+        dopri: &Dopri5,
+    ) -> Option<(usize, f64)> {
+        if self.before.is_empty() {
+            return None;
+        }
+        let n = sys.model_len();
+        sys.model
+            .event_functions(&dopri.state()[..n], &mut self.after);
+        let mut earliest: Option<(usize, f64)> = None;
+        for k in 0..self.before.len() {
+            if !(self.before[k] > 0.0 && self.after[k] <= 0.0) {
+                continue;
+            }
+            let (mut a, mut b) = (dopri.previous_time(), dopri.time());
+            while b - a > EVENT_TIME_TOL {
+                let mid = 0.5 * (a + b);
+                if mid <= a || mid >= b {
+                    break;
+                }
+                dopri.dense_output(mid, &mut self.y);
+                sys.model.event_functions(&self.y[..n], &mut self.probe);
+                if self.probe[k] > 0.0 {
+                    a = mid;
+                } else {
+                    b = mid;
+                }
+            }
+            if earliest.is_none_or(|(_, t)| b < t) {
+                earliest = Some((k, b));
+            }
+        }
+        earliest
+    }
+}
+
+/// A commanded tension ≤ 0 (or NaN) is a slack cable.
+#[inline]
+fn check_slack(t: f64, tensions: [f64; 2]) -> Result<(), RunError> {
+    if tensions[0] > 0.0 && tensions[1] > 0.0 {
+        return Ok(());
+    }
+    let cable = if tensions[0] > 0.0 { 2 } else { 1 };
+    Err(RunError::SlackCable {
+        t,
+        cable,
+        tension: tensions[cable - 1],
+    })
 }
 
 /// Samples the dense output on the grid t_k = k·Δt (computed, not accumulated, so the grid is
@@ -397,13 +481,15 @@ struct Sampler {
     /// Number of the model's own channels.
     model_channels: usize,
     energy0: f64,
+    /// Sum of the energy changes of the model events so far [J].
+    event_energy: f64,
     next: usize,
     samples: usize,
     period: f64,
 }
 
 impl Sampler {
-    /// Appends every grid sample with t_k ≤ `t` (the end of the last accepted step).
+    /// Appends every grid sample with t_k ≤ `t` (within the last accepted step).
     fn sample_through<M: CableModel>(
         &mut self,
         sys: &ClosedLoop<M>,
@@ -422,7 +508,7 @@ impl Sampler {
             if tk > t {
                 break;
             }
-            if tk == t {
+            if tk == dopri.time() {
                 self.y.copy_from_slice(dopri.state());
             } else {
                 dopri.dense_output(tk, &mut self.y);
@@ -434,7 +520,7 @@ impl Sampler {
             let eff = sys.model.effector(model_state);
             let energy = sys.model.energy(model_state);
             let (work, dissipated) = (y[n + 2], y[n + 3]);
-            let residual = energy.total() - self.energy0 - work + dissipated;
+            let residual = energy.total() - self.energy0 - work + dissipated - self.event_energy;
             let m = self.model_channels;
             self.series.push_row_with(|row| {
                 let (common, rest) = row.split_at_mut(COMMON_CHANNELS.len());

@@ -63,6 +63,19 @@ pub struct Equilibrium {
     pub residual: f64,
 }
 
+/// A discrete change of a model's state at a located time (e.g. a lumped node passing a pulley).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ModelEvent {
+    /// Time of the event [s] (located to 1e-12 s on the dense output).
+    pub t: f64,
+    /// Cable concerned (1 or 2).
+    pub cable: usize,
+    /// What happened, in the model's words (e.g. "node 19 leaves the reel").
+    pub what: String,
+    /// Change of the mechanical energy (kinetic + elastic + gravity) caused by the event [J].
+    pub energy_change: f64,
+}
+
 /// A cable model of the two-cable planar CDPR: state, right-hand side, energy and tensions.
 ///
 /// The commanded tensions `[T1, T2]` act at the reels; how they reach the effector is the model's
@@ -95,6 +108,30 @@ pub trait CableModel {
     /// Power dissipated inside the model [W] (damping); 0 for conservative models.
     fn dissipation(&self, _state: &[f64]) -> f64 {
         0.0
+    }
+
+    /// Number of event functions (0 for models without discrete events).
+    fn event_count(&self) -> usize {
+        0
+    }
+
+    /// Event functions g_k(state): positive while nothing happens; event k occurs when g_k falls
+    /// from > 0 to ≤ 0 between two accepted steps. They depend on the model's discrete mode and
+    /// are continuous in the state within a mode.
+    fn event_functions(&self, _state: &[f64], _out: &mut [f64]) {}
+
+    /// Applies event `index` at time `t` to `state` (in place) and the model's discrete mode, and
+    /// says what happened. Called at the located crossing, where g_index ≤ 0.
+    fn apply_event(
+        &mut self,
+        index: usize,
+        t: f64,
+        _state: &mut [f64],
+    ) -> Result<ModelEvent, ModelError> {
+        Err(ModelError::State {
+            t,
+            why: format!("model {} has no event {index}", self.name()),
+        })
     }
 
     /// Names of the model's own output channels (with units), after the common ones.

@@ -503,10 +503,11 @@ fn restart_counts_one_evaluation_and_continues_from_the_new_state() {
     while d.time() < 0.5 {
         d.step(&mut sys, 2.0).unwrap();
     }
-    let t_r = d.time();
+    // Restart inside the last accepted step, as a located model event does.
+    let t_r = 0.5 * (d.previous_time() + d.time());
     let h_last = d.time() - d.previous_time();
     let before = d.stats();
-    d.restart(&mut sys, &[3.0]);
+    d.restart(&mut sys, t_r, &[3.0]);
     let after = d.stats();
     assert_eq!(after.rhs_evals, before.rhs_evals + 1);
     assert_eq!(after.restarts, before.restarts + 1);

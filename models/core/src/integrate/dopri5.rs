@@ -206,9 +206,11 @@ impl Dopri5 {
         Ok(())
     }
 
-    /// Continues from a changed state at the current time (after a model event): re-evaluates the
-    /// derivative and keeps the step size of the last accepted step (MODELS.md §6).
-    pub fn restart<S: OdeSystem>(&mut self, sys: &mut S, y: &[f64]) {
+    /// Continues from a changed state `y` at time `t` within the last accepted step (after a model
+    /// event): re-evaluates the derivative and keeps the step size of the last accepted step
+    /// (MODELS.md §6). The dense output of the abandoned step is discarded.
+    pub fn restart<S: OdeSystem>(&mut self, sys: &mut S, t: f64, y: &[f64]) {
+        self.t = t;
         self.y.copy_from_slice(y);
         sys.rhs(self.t, &self.y, &mut self.k1);
         self.stats.rhs_evals += 1;

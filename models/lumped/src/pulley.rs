@@ -1,0 +1,108 @@
+//! The pulley rule of the lumped model (MODELS.md §4), all in one place.
+//!
+//! Side rule: node P_j of cable i is stored when (P_j − A_i)·e_out,i > 0. Along each cable the
+//! stored nodes are 0 … r−1 and the free nodes r … N−1. Two events per cable change r:
+//! - the last stored node P_{r−1} reaches the pulley (g_s = (P_{r−1} − A)·e_out falls through 0):
+//!   it becomes free at A − ε e_out, velocity kept; r ← r − 1;
+//! - the first free node P_r reaches the pulley (g_f = (P_r − A)·e_out rises through 0): it becomes
+//!   stored at A + ε e_out with z = ż = 0, ẋ kept; r ← r + 1.
+//!
+//! A third function per cable watches every other node: a stored node other than the last one
+//! leaving the reel, or a free node other than the first one passing the pulley, breaks the
+//! ordering the model relies on and stops the run as a modelling error.
+
+use crate::{E_OUT, Lumped};
+use cdpr_core::model::{CableModel, ModelError, ModelEvent};
+
+/// Offset ε that keeps the side rule unambiguous after an event [m].
+pub const PULLEY_OFFSET: f64 = 1e-12;
+
+/// Functions per cable: last stored node, first free node, ordering watch.
+const PER_CABLE: usize = 3;
+/// Event functions of the model.
+pub(crate) const EVENT_COUNT: usize = 2 * PER_CABLE;
+
+/// Signed distance of node j beyond the pulley along e_out (> 0: on the reel side) [m].
+fn beyond(model: &Lumped, y: &[f64], cable: usize, j: usize) -> f64 {
+    (y[model.index(cable, j)] - model.pulley(cable).x) * E_OUT[cable]
+}
+
+/// All event functions, positive while nothing happens (see [`CableModel::event_functions`]).
+pub(crate) fn event_functions(model: &Lumped, y: &[f64], out: &mut [f64]) {
+    let n = model.elements;
+    for cable in 0..2 {
+        let r = model.stored()[cable];
+        let g = &mut out[PER_CABLE * cable..PER_CABLE * (cable + 1)];
+        g[0] = if r > 0 {
+            beyond(model, y, cable, r - 1)
+        } else {
+            1.0
+        };
+        g[1] = if r < n {
+            -beyond(model, y, cable, r)
+        } else {
+            1.0
+        };
+        let stored_watch = (0..r.saturating_sub(1)).map(|j| beyond(model, y, cable, j));
+        let free_watch = (r + 1..n).map(|j| -beyond(model, y, cable, j));
+        g[2] = stored_watch.chain(free_watch).fold(1.0, f64::min);
+    }
+}
+
+/// Applies event `index` at `t` (see the module documentation).
+pub(crate) fn apply_event(
+    model: &mut Lumped,
+    index: usize,
+    t: f64,
+    y: &mut [f64],
+) -> Result<ModelEvent, ModelError> {
+    let (cable, kind) = (index / PER_CABLE, index % PER_CABLE);
+    let mut stored = model.stored();
+    let r = stored[cable];
+    let np = model.positions_len();
+    let before = model.energy(y).total();
+    let pulley = model.pulley(cable).x;
+    let (j, what) = match kind {
+        0 => {
+            if r == 1 {
+                return Err(ModelError::State {
+                    t,
+                    why: format!(
+                        "cable {} is paid out to its reel end: lengthen cable.modelled_length",
+                        cable + 1
+                    ),
+                });
+            }
+            let j = r - 1;
+            y[model.index(cable, j)] = pulley - PULLEY_OFFSET * E_OUT[cable];
+            stored[cable] = r - 1;
+            (j, "leaves the reel")
+        }
+        1 => {
+            let j = r;
+            let i = model.index(cable, j);
+            y[i] = pulley + PULLEY_OFFSET * E_OUT[cable];
+            y[i + 1] = 0.0;
+            y[np + i + 1] = 0.0;
+            stored[cable] = r + 1;
+            (j, "is reeled in")
+        }
+        _ => {
+            return Err(ModelError::State {
+                t,
+                why: format!(
+                    "cable {}: a node passed the pulley out of order (stored nodes must be 0..{r}); \
+                     the lumped model's pulley rule does not hold",
+                    cable + 1
+                ),
+            });
+        }
+    };
+    model.set_stored(stored);
+    Ok(ModelEvent {
+        t,
+        cable: cable + 1,
+        what: format!("node {j} {what}"),
+        energy_change: model.energy(y).total() - before,
+    })
+}
