@@ -15,6 +15,7 @@ use cdpr_elastic::{Elastic, eq15_frequency};
 use cdpr_lumped::Lumped;
 
 pub mod acceptance;
+pub mod irvine;
 
 /// Why a scenario could not be simulated or analysed.
 #[derive(Debug, thiserror::Error)]

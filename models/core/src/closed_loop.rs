@@ -150,7 +150,7 @@ pub enum RunError {
 }
 
 /// Output of a run: sampled channels, counters, the initial equilibrium, the state at the end.
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub struct Run {
     pub model: &'static str,
     pub series: TimeSeries,
@@ -164,6 +164,21 @@ pub struct Run {
     pub events: Vec<ModelEvent>,
     /// Wall-clock time of the integration [s] (the only non-reproducible number of a run).
     pub wall_s: f64,
+}
+
+/// A summary, not the samples (a failed `unwrap` would otherwise print megabytes).
+impl std::fmt::Debug for Run {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Run")
+            .field("model", &self.model)
+            .field("samples", &self.series.len())
+            .field("channels", &self.series.names())
+            .field("t_reached", &self.t_reached)
+            .field("stats", &self.stats)
+            .field("events", &self.events.len())
+            .field("wall_s", &self.wall_s)
+            .finish_non_exhaustive()
+    }
 }
 
 /// A failed run: the reason and everything sampled before it.

@@ -19,6 +19,8 @@ pub const HF_FROM: f64 = 100.0;
 pub const REFINED_FROM: f64 = 2.0;
 /// Zero-padding factor of the refined spectrum.
 pub const PAD: usize = 16;
+/// Two events of one cable closer than this are counted as chatter [s].
+pub const CHATTER_WINDOW: f64 = 1e-3;
 
 /// MODELS.md §7 metrics of one run. Keys are those of `metrics.json`.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -67,8 +69,15 @@ pub struct Metrics {
     /// Effector z and PID force at the initial equilibrium [m, N].
     pub z0: f64,
     pub f0: f64,
-    /// Largest |E − E0 − W + D| over the run [J] (energy balance residual).
+    /// Largest |E − E0 − W + D − ΣΔE| over the run [J] (energy balance residual).
     pub energy_residual_max: f64,
+    /// Model events (lumped: nodes passing a pulley).
+    pub pulley_events: usize,
+    /// Energy removed by the events, −ΣΔE [J] (positive: lost).
+    pub pulley_energy_loss: f64,
+    /// Events less than [`CHATTER_WINDOW`] after the previous event of the same cable (a node
+    /// hovering at the pulley).
+    pub pulley_chatter: usize,
     /// Integrator cost.
     pub rhs_evals: u64,
     pub steps_accepted: u64,
@@ -174,6 +183,15 @@ impl Metrics {
             _ => f64::NAN,
         };
         let energy_residual_max = max_abs(&col("e_residual"));
+        let mut last_event = [f64::NEG_INFINITY; 2];
+        let mut pulley_chatter = 0;
+        for e in &run.events {
+            let slot = &mut last_event[(e.cable - 1).min(1)];
+            if e.t - *slot < CHATTER_WINDOW {
+                pulley_chatter += 1;
+            }
+            *slot = e.t;
+        }
 
         Self {
             model: run.model.to_owned(),
@@ -206,6 +224,9 @@ impl Metrics {
             z0: z.first().copied().unwrap_or(f64::NAN),
             f0: run.equilibrium.force,
             energy_residual_max,
+            pulley_events: run.events.len(),
+            pulley_energy_loss: -run.events.iter().map(|e| e.energy_change).sum::<f64>(),
+            pulley_chatter,
             rhs_evals: run.stats.rhs_evals,
             steps_accepted: run.stats.steps_accepted,
             steps_rejected: run.stats.steps_rejected,

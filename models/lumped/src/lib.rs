@@ -7,10 +7,13 @@
 //! pulley measures its length along the cable path over the pulley (eq. 4). Nodes pass the pulley
 //! as located events ([`pulley`]); no node ever changes mass, so the cable mass is conserved exactly.
 //!
-//! State: positions then velocities, each ordered cable 1 nodes 0…N−1, cable 2 nodes 0…N−1,
-//! effector; every node has (x, z), so the state has 4(2N + 1) components (stored nodes keep
-//! z = ż = 0). The number of stored nodes r_i per cable is the model's discrete mode.
+//! State: positions then velocities, each laid out as structure-of-arrays so that the spring loop
+//! vectorises: `[x of cable 1 nodes 0…N−1 | z of cable 1 | x of cable 2 | z of cable 2 | x_P, z_P]`,
+//! 4N + 2 components, then the velocities in the same order; the state has 2(4N + 2) components
+//! (stored nodes keep z = ż = 0). The number of stored nodes r_i per cable is the model's discrete
+//! mode.
 
+pub mod chain;
 mod pulley;
 mod statics;
 
@@ -41,6 +44,40 @@ pub struct Lumped {
     pub damping: f64,
     /// Number of stored nodes r_i of each cable (nodes 0 … r_i − 1 lie beyond the pulley).
     stored: [usize; 2],
+    /// Per cable, the forces each spring puts on its two end nodes (allocated once).
+    scratch: [SpringForces; 2],
+}
+
+/// Forces of the springs j = 0 … N−1 of one cable on their end nodes a = P_j and b = P_{j+1} [N].
+#[derive(Debug, Clone, PartialEq, Default)]
+struct SpringForces {
+    ax: Vec<f64>,
+    az: Vec<f64>,
+    bx: Vec<f64>,
+    bz: Vec<f64>,
+}
+
+impl SpringForces {
+    fn new(n: usize) -> Self {
+        Self {
+            ax: vec![0.0; n],
+            az: vec![0.0; n],
+            bx: vec![0.0; n],
+            bz: vec![0.0; n],
+        }
+    }
+}
+
+/// The lumped spring law (MODELS.md §4): T = k0 (λ − l0) + (C/l0) λ̇ while taut (λ > l0), else 0;
+/// a damping part that would make the spring push is clipped, so T ≥ 0 always.
+/// `stiffness` k0 [N/m], `segment` l0 [m], `damping` C/l0 [N s/m], `length` λ [m], `rate` λ̇ [m/s].
+#[inline]
+pub fn spring_tension(stiffness: f64, segment: f64, damping: f64, length: f64, rate: f64) -> f64 {
+    let stretch = length - segment;
+    if stretch <= 0.0 {
+        return 0.0;
+    }
+    (stiffness * stretch + damping * rate).max(0.0)
 }
 
 /// Direction from each pulley towards its reel, e_out,i (MODELS.md §4).
@@ -71,6 +108,7 @@ impl Lumped {
             stiffness: cable.axial_stiffness() / segment,
             damping: cable.axial_damping / segment,
             stored: [n / 2, n / 2],
+            scratch: [SpringForces::new(n), SpringForces::new(n)],
         })
     }
 
@@ -96,17 +134,26 @@ impl Lumped {
         )
     }
 
-    /// Number of position coordinates, 2(2N + 1).
+    /// Number of position coordinates, 4N + 2.
     pub fn positions_len(&self) -> usize {
-        2 * (2 * self.elements + 1)
+        4 * self.elements + 2
     }
 
     /// Index of the x coordinate of node `j` of `cable` (j = N is the effector).
-    pub fn index(&self, cable: usize, j: usize) -> usize {
+    pub fn xi(&self, cable: usize, j: usize) -> usize {
         if j == self.elements {
             4 * self.elements
         } else {
-            2 * (cable * self.elements + j)
+            2 * cable * self.elements + j
+        }
+    }
+
+    /// Index of the z coordinate of node `j` of `cable` (j = N is the effector).
+    pub fn zi(&self, cable: usize, j: usize) -> usize {
+        if j == self.elements {
+            4 * self.elements + 1
+        } else {
+            (2 * cable + 1) * self.elements + j
         }
     }
 
@@ -119,19 +166,20 @@ impl Lumped {
         }
     }
 
-    fn point(&self, y: &[f64], i: usize) -> Vector2<f64> {
-        Vector2::new(y[i], y[i + 1])
+    /// Position of node `j` of `cable` (the effector at j = N) [m].
+    pub fn node(&self, y: &[f64], cable: usize, j: usize) -> Vector2<f64> {
+        Vector2::new(y[self.xi(cable, j)], y[self.zi(cable, j)])
     }
 
-    /// Spring law: T = k0 (λ − l0) + (C/l0) λ̇ while taut, else 0; a damping part that would push
-    /// is clipped so the spring never pushes (MODELS.md §4).
+    /// Velocity of node `j` of `cable` [m/s].
+    pub fn node_velocity(&self, y: &[f64], cable: usize, j: usize) -> Vector2<f64> {
+        let np = self.positions_len();
+        Vector2::new(y[np + self.xi(cable, j)], y[np + self.zi(cable, j)])
+    }
+
     #[inline]
     fn spring_tension(&self, length: f64, rate: f64) -> f64 {
-        let stretch = length - self.segment;
-        if stretch <= 0.0 {
-            return 0.0;
-        }
-        (self.stiffness * stretch + self.damping * rate).max(0.0)
+        spring_tension(self.stiffness, self.segment, self.damping, length, rate)
     }
 
     /// Length λ_j of spring j of `cable` along the cable path, its rate λ̇_j, and the unit vectors
@@ -139,10 +187,11 @@ impl Lumped {
     /// (eq. 4): λ = |P_{r−1} A| + |A P_r|, pulling both ends towards A.
     #[inline]
     fn spring(&self, y: &[f64], cable: usize, j: usize) -> (f64, f64, Vector2<f64>, Vector2<f64>) {
-        let np = self.positions_len();
-        let (ia, ib) = (self.index(cable, j), self.index(cable, j + 1));
-        let (a, b) = (self.point(y, ia), self.point(y, ib));
-        let (va, vb) = (self.point(y, np + ia), self.point(y, np + ib));
+        let (a, b) = (self.node(y, cable, j), self.node(y, cable, j + 1));
+        let (va, vb) = (
+            self.node_velocity(y, cable, j),
+            self.node_velocity(y, cable, j + 1),
+        );
         if j + 1 == self.stored[cable] {
             let pulley = self.pulley(cable);
             let (da, db) = (pulley - a, pulley - b);
@@ -158,34 +207,74 @@ impl Lumped {
     }
 
     /// Net forces on every position coordinate [N] (gravity included; stored nodes' vertical
-    /// forces are constraint-reacted and zeroed), for the commanded tensions.
-    fn accumulate_forces(&self, y: &[f64], tensions: [f64; 2], forces: &mut [f64]) {
+    /// forces are constraint-reacted and zeroed), for the commanded tensions. The springs between
+    /// two cable nodes are computed in one vectorisable sweep; the straddling spring and the spring
+    /// to the effector are then recomputed along the cable path.
+    fn forces(&mut self, y: &[f64], tensions: [f64; 2], out: &mut [f64]) {
         let n = self.elements;
-        forces.fill(0.0);
+        let np = self.positions_len();
+        let (k, l0, c) = (self.stiffness, self.segment, self.damping);
+        let mut effector = Vector2::new(0.0, -self.effector_mass * self.gravity);
         for cable in 0..2 {
-            let i0 = self.index(cable, 0);
-            forces[i0] += tensions[cable] * E_OUT[cable];
-            for j in 0..n {
-                let (length, rate, ua, ub) = self.spring(y, cable, j);
-                let t = self.spring_tension(length, rate);
-                let (ia, ib) = (self.index(cable, j), self.index(cable, j + 1));
-                forces[ia] += t * ua.x;
-                forces[ia + 1] += t * ua.y;
-                forces[ib] += t * ub.x;
-                forces[ib + 1] += t * ub.y;
-            }
-        }
-        for cable in 0..2 {
-            for j in 0..n {
-                let i = self.index(cable, j);
-                if j < self.stored[cable] {
-                    forces[i + 1] = 0.0;
-                } else {
-                    forces[i + 1] -= self.node_mass * self.gravity;
+            let mut s = std::mem::take(&mut self.scratch[cable]);
+            let (bx, bz) = (self.xi(cable, 0), self.zi(cable, 0));
+            let (x, z) = (&y[bx..bx + n], &y[bz..bz + n]);
+            let (vx, vz) = (&y[np + bx..np + bx + n], &y[np + bz..np + bz + n]);
+            let m = n - 1;
+            let (ax, az, sbx, sbz) = (
+                &mut s.ax[..m],
+                &mut s.az[..m],
+                &mut s.bx[..m],
+                &mut s.bz[..m],
+            );
+            if c == 0.0 {
+                // Undamped: max(k (λ − l0), 0) is the whole tension-only law, branch-free.
+                for j in 0..m {
+                    let (dx, dz) = (x[j + 1] - x[j], z[j + 1] - z[j]);
+                    let length = (dx * dx + dz * dz).sqrt();
+                    let per_length = (k * (length - l0)).max(0.0) / length;
+                    ax[j] = per_length * dx;
+                    az[j] = per_length * dz;
+                    sbx[j] = -per_length * dx;
+                    sbz[j] = -per_length * dz;
+                }
+            } else {
+                for j in 0..m {
+                    let (dx, dz) = (x[j + 1] - x[j], z[j + 1] - z[j]);
+                    let length = (dx * dx + dz * dz).sqrt();
+                    let inv = 1.0 / length;
+                    let rate = (dx * (vx[j + 1] - vx[j]) + dz * (vz[j + 1] - vz[j])) * inv;
+                    let stretch = length - l0;
+                    let taut = (k * stretch + c * rate).max(0.0);
+                    let per_length = if stretch > 0.0 { taut * inv } else { 0.0 };
+                    ax[j] = per_length * dx;
+                    az[j] = per_length * dz;
+                    sbx[j] = -per_length * dx;
+                    sbz[j] = -per_length * dz;
                 }
             }
+            let r = self.stored[cable];
+            for j in [Some(n - 1), r.checked_sub(1)].into_iter().flatten() {
+                let (length, rate, ua, ub) = self.spring(y, cable, j);
+                let t = self.spring_tension(length, rate);
+                (s.ax[j], s.az[j], s.bx[j], s.bz[j]) = (t * ua.x, t * ua.y, t * ub.x, t * ub.y);
+            }
+            let (fx, rest) = out[bx..].split_at_mut(n);
+            let fz = &mut rest[..n];
+            fx[0] = s.ax[0] + tensions[cable] * E_OUT[cable];
+            fz[0] = s.az[0];
+            for j in 1..n {
+                fx[j] = s.ax[j] + s.bx[j - 1];
+                fz[j] = s.az[j] + s.bz[j - 1];
+            }
+            let weight = self.node_mass * self.gravity;
+            fz[..r].fill(0.0);
+            fz[r..].iter_mut().for_each(|f| *f -= weight);
+            effector += Vector2::new(s.bx[n - 1], s.bz[n - 1]);
+            self.scratch[cable] = s;
         }
-        forces[4 * n + 1] -= self.effector_mass * self.gravity;
+        out[4 * n] = effector.x;
+        out[4 * n + 1] = effector.y;
     }
 
     /// Tension of spring j of `cable` [N].
@@ -203,8 +292,7 @@ impl Lumped {
             return free_springs;
         }
         let (length, _, _, _) = self.spring(y, cable, r - 1);
-        let ib = self.index(cable, r);
-        let free_part = (self.pulley(cable) - self.point(y, ib)).norm();
+        let free_part = (self.pulley(cable) - self.node(y, cable, r)).norm();
         free_springs + self.segment * free_part / length
     }
 
@@ -232,51 +320,43 @@ impl CableModel for Lumped {
     }
 
     fn rhs(&mut self, _t: f64, y: &[f64], tensions: [f64; 2], rate: &mut [f64]) {
+        let n = self.elements;
         let np = self.positions_len();
         let (dq, dv) = rate.split_at_mut(np);
         dq.copy_from_slice(&y[np..]);
-        self.accumulate_forces(y, tensions, dv);
+        self.forces(y, tensions, dv);
+        let inv_m = 1.0 / self.node_mass;
+        dv[..4 * n].iter_mut().for_each(|a| *a *= inv_m);
+        dv[4 * n] /= self.effector_mass;
+        dv[4 * n + 1] /= self.effector_mass;
         for cable in 0..2 {
-            for j in 0..self.elements {
-                let i = self.index(cable, j);
-                dv[i] /= self.node_mass;
-                dv[i + 1] /= self.node_mass;
-                if j < self.stored[cable] {
-                    dq[i + 1] = 0.0;
-                }
-            }
+            let bz = self.zi(cable, 0);
+            dq[bz..bz + self.stored[cable]].fill(0.0);
         }
-        let ip = 4 * self.elements;
-        dv[ip] /= self.effector_mass;
-        dv[ip + 1] /= self.effector_mass;
     }
 
     fn effector(&self, y: &[f64]) -> Effector {
-        let (ip, np) = (4 * self.elements, self.positions_len());
         Effector {
-            position: self.point(y, ip),
-            velocity: self.point(y, np + ip),
+            position: self.node(y, 0, self.elements),
+            velocity: self.node_velocity(y, 0, self.elements),
         }
     }
 
     /// The reel end P_0 moving along e_out takes cable in.
     fn reel_speeds(&self, y: &[f64]) -> [f64; 2] {
-        let np = self.positions_len();
-        [0, 1].map(|c| y[np + self.index(c, 0)] * E_OUT[c])
+        [0, 1].map(|c| self.node_velocity(y, c, 0).x * E_OUT[c])
     }
 
     fn energy(&self, y: &[f64]) -> Energy {
-        let np = self.positions_len();
         let mut e = Energy::default();
         for j in 0..=self.elements {
             for cable in 0..2 {
                 if j == self.elements && cable == 1 {
                     break; // the effector is shared
                 }
-                let i = self.index(cable, j);
                 let m = self.mass(j);
-                e.kinetic += 0.5 * m * (y[np + i] * y[np + i] + y[np + i + 1] * y[np + i + 1]);
-                e.gravity += m * self.gravity * y[i + 1];
+                e.kinetic += 0.5 * m * self.node_velocity(y, cable, j).norm_squared();
+                e.gravity += m * self.gravity * self.node(y, cable, j).y;
             }
         }
         for cable in 0..2 {

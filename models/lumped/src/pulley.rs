@@ -24,7 +24,7 @@ pub(crate) const EVENT_COUNT: usize = 2 * PER_CABLE;
 
 /// Signed distance of node j beyond the pulley along e_out (> 0: on the reel side) [m].
 fn beyond(model: &Lumped, y: &[f64], cable: usize, j: usize) -> f64 {
-    (y[model.index(cable, j)] - model.pulley(cable).x) * E_OUT[cable]
+    (y[model.xi(cable, j)] - model.pulley(cable).x) * E_OUT[cable]
 }
 
 /// All event functions, positive while nothing happens (see [`CableModel::event_functions`]).
@@ -74,16 +74,16 @@ pub(crate) fn apply_event(
                 });
             }
             let j = r - 1;
-            y[model.index(cable, j)] = pulley - PULLEY_OFFSET * E_OUT[cable];
+            y[model.xi(cable, j)] = pulley - PULLEY_OFFSET * E_OUT[cable];
             stored[cable] = r - 1;
             (j, "leaves the reel")
         }
         1 => {
             let j = r;
-            let i = model.index(cable, j);
-            y[i] = pulley + PULLEY_OFFSET * E_OUT[cable];
-            y[i + 1] = 0.0;
-            y[np + i + 1] = 0.0;
+            let (ix, iz) = (model.xi(cable, j), model.zi(cable, j));
+            y[ix] = pulley + PULLEY_OFFSET * E_OUT[cable];
+            y[iz] = 0.0;
+            y[np + iz] = 0.0;
             stored[cable] = r + 1;
             (j, "is reeled in")
         }

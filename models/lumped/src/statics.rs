@@ -13,8 +13,8 @@ use cdpr_core::statics::{self, NewtonOptions, StaticProblem};
 use nalgebra::Vector2;
 
 /// The unknowns ↔ state map and the force residual for a fixed split r.
-struct Problem<'a> {
-    model: &'a Lumped,
+struct Problem {
+    model: Lumped,
     effector_x: f64,
     tension_sum: f64,
     /// State vector being assembled (velocities stay zero).
@@ -24,25 +24,24 @@ struct Problem<'a> {
     map: Vec<usize>,
 }
 
-impl<'a> Problem<'a> {
-    fn new(model: &'a Lumped, effector_x: f64, tension_sum: f64) -> Self {
+impl Problem {
+    fn new(model: Lumped, effector_x: f64, tension_sum: f64) -> Self {
         let mut map = Vec::new();
         for cable in 0..2 {
             for j in 0..model.elements {
-                let i = model.index(cable, j);
-                map.push(i);
+                map.push(model.xi(cable, j));
                 if j >= model.stored()[cable] {
-                    map.push(i + 1);
+                    map.push(model.zi(cable, j));
                 }
             }
         }
-        map.push(4 * model.elements + 1);
+        map.push(model.zi(0, model.elements));
         Self {
+            y: vec![0.0; model.state_len()],
+            forces: vec![0.0; model.positions_len()],
             model,
             effector_x,
             tension_sum,
-            y: vec![0.0; model.state_len()],
-            forces: vec![0.0; model.positions_len()],
             map,
         }
     }
@@ -62,7 +61,7 @@ impl<'a> Problem<'a> {
     }
 }
 
-impl StaticProblem for Problem<'_> {
+impl StaticProblem for Problem {
     fn dimension(&self) -> usize {
         self.map.len() + 1
     }
@@ -72,16 +71,23 @@ impl StaticProblem for Problem<'_> {
     fn residual(&mut self, u: &[f64], r: &mut [f64]) {
         self.load(u);
         let tensions = self.tensions(u[self.map.len()]);
-        self.model
-            .accumulate_forces(&self.y, tensions, &mut self.forces);
+        self.model.forces(&self.y, tensions, &mut self.forces);
         for (k, &i) in self.map.iter().enumerate() {
             r[k] = self.forces[i];
         }
         // The effector's horizontal balance closes the system for F0.
         r[self.map.len()] = self.forces[4 * self.model.elements];
     }
-    fn scale(&self, _i: usize) -> f64 {
-        0.1
+    /// Finite-difference scales: 1e-4 m for coordinates, a 6e-10 m step, far inside a spring's
+    /// stretch (T/k0 = 8e-6 m at 60 N; a step beyond it slackens the spring and corrupts the
+    /// Jacobian) and still moving forces by 4e-3 N against a 2e-9 N round-off. ΣT for F0, on
+    /// which the residual depends linearly.
+    fn scale(&self, i: usize) -> f64 {
+        if i == self.map.len() {
+            self.tension_sum
+        } else {
+            1e-4
+        }
     }
 }
 
@@ -103,20 +109,54 @@ fn guess(model: &mut Lumped, effector: Vector2<f64>, tension: f64, ea: f64) -> V
         for j in 0..n {
             // Unstrained distance of node j from the pulley along the cable path (negative: stored).
             let s = free - (n - j) as f64 * model.segment;
-            let i = model.index(cable, j);
             let p = if s >= 0.0 {
                 a + u * (s * stretch)
             } else {
                 a + Vector2::new(E_OUT[cable], 0.0) * (-s * stretch)
             };
-            y[i] = p.x;
-            y[i + 1] = if s >= 0.0 { p.y } else { 0.0 };
+            y[model.xi(cable, j)] = p.x;
+            y[model.zi(cable, j)] = if s >= 0.0 { p.y } else { 0.0 };
         }
     }
     y[4 * n] = effector.x;
     y[4 * n + 1] = effector.y;
     model.set_stored(stored);
     y
+}
+
+/// Splits tried before giving up (a start needs at most one or two shifts).
+const MAX_SPLITS: usize = 6;
+
+/// (P_j − A)·e_out of node j of `cable` (> 0: stored side).
+fn beyond(model: &Lumped, y: &[f64], cable: usize, j: usize) -> f64 {
+    (y[model.xi(cable, j)] - model.pulley(cable).x) * E_OUT[cable]
+}
+
+/// Switches to the split `stored`: a node changing sides starts just on its new side of the
+/// pulley, on its new path (the straddling spring's length has a kink at the pulley that Newton
+/// cannot cross).
+fn reclassify(model: &mut Lumped, y: &mut [f64], stored: [usize; 2], effector_x: f64) {
+    let n = model.elements;
+    let effector = Vector2::new(effector_x, y[model.zi(0, n)]);
+    for cable in 0..2 {
+        let (old, new) = (model.stored()[cable], stored[cable]);
+        if old == new {
+            continue;
+        }
+        let a = model.pulley(cable);
+        let j = old.min(new);
+        let gap = (model.node(y, cable, j) - a)
+            .norm()
+            .max(1e-3 * model.segment);
+        let p = if new > old {
+            a + Vector2::new(E_OUT[cable] * gap, 0.0)
+        } else {
+            a + (effector - a).normalize() * gap
+        };
+        y[model.xi(cable, j)] = p.x;
+        y[model.zi(cable, j)] = p.y;
+    }
+    model.set_stored(stored);
 }
 
 /// Equilibrium with the split found by the side rule (MODELS.md §2, §4).
@@ -139,48 +179,36 @@ pub(crate) fn equilibrium(
     let ea = model.stiffness * model.segment;
     let mut y = guess(model, Vector2::new(effector_x, sag), 0.5 * tension_sum, ea);
     let n = model.elements;
-    for _attempt in 0..4 {
-        let problem_model = model.clone();
-        let mut problem = Problem::new(&problem_model, effector_x, tension_sum);
+    for _attempt in 0..MAX_SPLITS {
+        let mut problem = Problem::new(model.clone(), effector_x, tension_sum);
         let mut u: Vec<f64> = problem.map.iter().map(|&i| y[i]).collect();
         u.push(0.0);
-        let report = statics::solve(&mut problem, &mut u, NewtonOptions::default())?;
+        let solved = statics::solve(&mut problem, &mut u, NewtonOptions::default());
         problem.load(&u);
         y.copy_from_slice(&problem.y);
-        let force = u[problem.map.len()];
-        // Side rule at the solution: shift the split where the last stored node is not beyond the
-        // pulley or the first free node is.
         let mut stored = model.stored();
+        let report = solved?;
+        // Side rule at the solution: shift the split where the last stored node is not beyond
+        // the pulley or the first free node is.
         let mut consistent = true;
-        for cable in 0..2 {
-            let r = stored[cable];
-            let side = |j: usize| (y[model.index(cable, j)] - model.pulley(cable).x) * E_OUT[cable];
-            if r > 0 && side(r - 1) <= 0.0 {
-                stored[cable] = r - 1;
+        for (cable, r) in stored.iter_mut().enumerate() {
+            if *r > 0 && beyond(model, &y, cable, *r - 1) <= 0.0 {
+                *r -= 1;
                 consistent = false;
-            } else if r < n && side(r) > 0.0 {
-                stored[cable] = r + 1;
+            } else if *r < n && beyond(model, &y, cable, *r) > 0.0 {
+                *r += 1;
                 consistent = false;
             }
         }
         if consistent {
             return Ok(Equilibrium {
                 state: y,
-                force,
+                force: u[problem.map.len()],
                 iterations: report.iterations,
                 residual: report.residual,
             });
         }
-        for cable in 0..2 {
-            // A node changing sides starts on the line z = 0 (stored) or just off it (free).
-            for j in 0..n {
-                let i = model.index(cable, j);
-                if j < stored[cable] {
-                    y[i + 1] = 0.0;
-                }
-            }
-        }
-        model.set_stored(stored);
+        reclassify(model, &mut y, stored, effector_x);
     }
     Err(ModelError::State {
         t: 0.0,
