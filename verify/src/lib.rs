@@ -35,7 +35,7 @@ pub enum SimulateError {
 /// A scenario's model, ready for the closed loop (the one place that matches on the model kind).
 pub enum AnyModel {
     Elastic(Elastic),
-    Lumped(Lumped),
+    Lumped(Box<Lumped>),
 }
 
 impl AnyModel {
@@ -43,7 +43,7 @@ impl AnyModel {
     pub fn new(scenario: &Scenario) -> Result<Self, SimulateError> {
         match scenario.model.kind {
             ModelKind::Elastic => Ok(AnyModel::Elastic(Elastic::new(scenario))),
-            ModelKind::Lumped => Ok(AnyModel::Lumped(Lumped::new(scenario)?)),
+            ModelKind::Lumped => Ok(AnyModel::Lumped(Box::new(Lumped::new(scenario)?))),
             kind => Err(SimulateError::ModelUnavailable(kind)),
         }
     }
@@ -80,7 +80,7 @@ pub fn metrics(scenario: &Scenario, run: &Run) -> Metrics {
 pub fn vertical_mode_at_end(scenario: &Scenario) -> Result<Mode, SimulateError> {
     match AnyModel::new(scenario)? {
         AnyModel::Elastic(m) => vertical_mode(ClosedLoop::new(m, scenario), scenario),
-        AnyModel::Lumped(m) => vertical_mode(ClosedLoop::new(m, scenario), scenario),
+        AnyModel::Lumped(m) => vertical_mode(ClosedLoop::new(*m, scenario), scenario),
     }
 }
 
