@@ -59,7 +59,7 @@ pub fn simulate(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Ru
             progress,
         )?),
         AnyModel::Lumped(m) => Ok(run_loop(
-            &mut ClosedLoop::new(m, scenario),
+            &mut ClosedLoop::new(*m, scenario),
             &opts,
             progress,
         )?),
