@@ -19,6 +19,8 @@ pub const HF_FROM: f64 = 100.0;
 pub const REFINED_FROM: f64 = 2.0;
 /// Zero-padding factor of the refined spectrum.
 pub const PAD: usize = 16;
+/// High-frequency local maxima kept in the metrics.
+pub const HF_PEAKS: usize = 8;
 /// Two events of one cable closer than this are counted as chatter [s].
 pub const CHATTER_WINDOW: f64 = 1e-3;
 
@@ -66,6 +68,9 @@ pub struct Metrics {
     /// relative to the main error peak [dB].
     pub err_hf_peak_rad_s: f64,
     pub err_hf_peak_db: f64,
+    /// The [`HF_PEAKS`] largest local maxima of the refined error spectrum above 100 rad/s,
+    /// as [ω rad/s, dB relative to the main error peak], largest first.
+    pub err_hf_peaks: Vec<[f64; 2]>,
     /// Effector z and PID force at the initial equilibrium [m, N].
     pub z0: f64,
     pub f0: f64,
@@ -178,10 +183,17 @@ impl Metrics {
         let whole = Spectrum::new(&z, dt, Window::Rectangular, 1).max_bin(0.0);
         let err_main = err_spec.refined.refined_peak(REFINED_FROM);
         let err_hf = err_spec.refined.largest_local_max_above(HF_FROM);
-        let err_hf_peak_db = match (err_hf, err_main) {
-            (Some(hf), Some(main)) => 20.0 * (hf.amplitude / main.amplitude).log10(),
-            _ => f64::NAN,
+        let db = |p: Peak| match err_main {
+            Some(main) => 20.0 * (p.amplitude / main.amplitude).log10(),
+            None => f64::NAN,
         };
+        let err_hf_peak_db = err_hf.map_or(f64::NAN, db);
+        let err_hf_peaks = err_spec
+            .refined
+            .local_maxima_above(HF_FROM, HF_PEAKS)
+            .into_iter()
+            .map(|p| [p.omega, db(p)])
+            .collect();
         let energy_residual_max = max_abs(&col("e_residual"));
         let mut last_event = [f64::NEG_INFINITY; 2];
         let mut pulley_chatter = 0;
@@ -221,6 +233,7 @@ impl Metrics {
             z_fft_0_5_bin: whole.map_or(0, |p| p.bin),
             err_hf_peak_rad_s: peak_omega(err_hf),
             err_hf_peak_db,
+            err_hf_peaks,
             z0: z.first().copied().unwrap_or(f64::NAN),
             f0: run.equilibrium.force,
             energy_residual_max,

@@ -123,6 +123,26 @@ impl Spectrum {
         }
     }
 
+    /// The `count` largest local maxima with ω > `min_omega` (refined), largest first.
+    pub fn local_maxima_above(&self, min_omega: f64, count: usize) -> Vec<Peak> {
+        let k0 = ((min_omega / self.omega_step).floor() as usize + 1).max(1);
+        let a = &self.amplitude;
+        let mut bins: Vec<usize> = (k0..a.len().saturating_sub(1))
+            .filter(|&k| a[k] > a[k - 1] && a[k] >= a[k + 1])
+            .collect();
+        bins.sort_by(|&x, &y| a[y].total_cmp(&a[x]).then(x.cmp(&y)));
+        bins.truncate(count);
+        bins.into_iter()
+            .map(|bin| {
+                self.refine(Peak {
+                    omega: self.omega(bin),
+                    amplitude: a[bin],
+                    bin,
+                })
+            })
+            .collect()
+    }
+
     /// The largest local maximum with ω > `min_omega` (refined), e.g. the discretisation modes
     /// above the physics of interest.
     pub fn largest_local_max_above(&self, min_omega: f64) -> Option<Peak> {

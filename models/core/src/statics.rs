@@ -16,6 +16,7 @@ pub trait StaticProblem {
     fn length_unknowns(&self) -> usize;
     /// Residual forces R(u) [N].
     fn residual(&mut self, unknowns: &[f64], residual: &mut [f64]);
+
     /// Finite-difference scale of unknown `i`: the step is ε^(1/3)·scale ≈ 6e-6·scale. It must be
     /// small against the residual's features (a tension-only spring's stretch T/k: a step beyond
     /// it goes slack and corrupts the column) and large against its round-off. Default 1.

@@ -196,7 +196,12 @@ impl Lumped {
             let pulley = self.pulley(cable);
             let (da, db) = (pulley - a, pulley - b);
             let (la, lb) = (da.norm(), db.norm());
-            let (ua, ub) = (da / la, db / lb);
+            // A node exactly at the pulley has no direction towards it; the limit of the path is
+            // the direction to the spring's other end (a light cable can drive a node there).
+            let toward = |d: Vector2<f64>, l: f64, other: Vector2<f64>| {
+                if l > 0.0 { d / l } else { other.normalize() }
+            };
+            let (ua, ub) = (toward(da, la, b - a), toward(db, lb, a - b));
             (la + lb, -ua.dot(&va) - ub.dot(&vb), ua, ub)
         } else {
             let d = b - a;
