@@ -1,0 +1,49 @@
+//! Cost of the lumped model (N = 40 per cable, 328 states): one closed-loop RHS evaluation and
+//! the 5 s paper run with DOPRI5 (about 2.1 M accepted steps and 13 M RHS evaluations).
+
+use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate};
+use cdpr_core::integrate::OdeSystem;
+use cdpr_core::scenario::{ModelKind, Scenario};
+use cdpr_lumped::Lumped;
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+use std::time::Duration;
+
+fn scenario() -> Scenario {
+    let mut s = Scenario::paper();
+    s.model.kind = ModelKind::Lumped;
+    s
+}
+
+fn rhs(c: &mut Criterion) {
+    let scenario = scenario();
+    let mut sys = ClosedLoop::new(Lumped::new(&scenario).unwrap(), &scenario);
+    let (y, _) = sys.initial_state().unwrap();
+    let mut dy = vec![0.0; y.len()];
+    c.bench_function("lumped/rhs", |b| {
+        b.iter(|| {
+            sys.rhs(black_box(0.1), black_box(&y), &mut dy);
+            black_box(&dy);
+        })
+    });
+}
+
+fn paper_run(c: &mut Criterion) {
+    let scenario = scenario();
+    let opts = RunOptions::from(&scenario);
+    let mut group = c.benchmark_group("lumped");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(120));
+    group.bench_function("paper_run_5s", |b| {
+        b.iter(|| {
+            let mut sys = ClosedLoop::new(Lumped::new(&scenario).unwrap(), &scenario);
+            let run = simulate(&mut sys, &opts, &mut |_| {}).unwrap();
+            black_box(run.stats.rhs_evals)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, rhs, paper_run);
+criterion_main!(benches);
