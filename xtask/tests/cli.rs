@@ -104,7 +104,7 @@ fn unknown_model_and_unimplemented_model_are_clear_errors() {
     let dir = temp_dir("model");
     for (model, expect) in [
         ("rigid", "unknown model `rigid`"),
-        ("lumped", "not implemented"),
+        ("fe", "not implemented"),
     ] {
         let output = xtask()
             .args(["simulate", "--model", model, "--out"])
