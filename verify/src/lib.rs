@@ -8,7 +8,7 @@ use cdpr_core::closed_loop::{ClosedLoop, Run, RunFailure, RunOptions, simulate a
 use cdpr_core::integrate::OdeSystem;
 use cdpr_core::metrics::Metrics;
 use cdpr_core::modal::{self, Mode};
-use cdpr_core::model::{CableModel, ModelError};
+use cdpr_core::model::{CableModel, Equilibrium, ModelError};
 use cdpr_core::scenario::{ModelKind, Scenario};
 use cdpr_core::trajectory::Step5;
 use cdpr_elastic::{Elastic, eq15_frequency};
@@ -78,16 +78,33 @@ pub fn metrics(scenario: &Scenario, run: &Run) -> Metrics {
 /// The closed-loop mode nearest eq. 15 at the static equilibrium at x2 (the effector's vertical
 /// mode), from the finite-difference Jacobian of model + PID + tension distribution.
 pub fn vertical_mode_at_end(scenario: &Scenario) -> Result<Mode, SimulateError> {
+    Ok(end_state(scenario)?.mode)
+}
+
+/// The settled end of the paper's move: the static equilibrium at x2 and the closed-loop
+/// vertical mode there.
+#[derive(Debug, Clone)]
+pub struct EndState {
+    /// Closed-loop mode nearest eq. 15.
+    pub mode: Mode,
+    /// Static equilibrium at x2 (MODELS.md §2 rule).
+    pub equilibrium: Equilibrium,
+    /// Effector position there [m].
+    pub effector: cdpr_core::Vector2<f64>,
+}
+
+/// [`EndState`] of the scenario's model.
+pub fn end_state(scenario: &Scenario) -> Result<EndState, SimulateError> {
     match AnyModel::new(scenario)? {
-        AnyModel::Elastic(m) => vertical_mode(ClosedLoop::new(m, scenario), scenario),
-        AnyModel::Lumped(m) => vertical_mode(ClosedLoop::new(*m, scenario), scenario),
+        AnyModel::Elastic(m) => end_state_of(ClosedLoop::new(m, scenario), scenario),
+        AnyModel::Lumped(m) => end_state_of(ClosedLoop::new(*m, scenario), scenario),
     }
 }
 
-fn vertical_mode<M: CableModel>(
+fn end_state_of<M: CableModel>(
     mut sys: ClosedLoop<M>,
     scenario: &Scenario,
-) -> Result<Mode, SimulateError> {
+) -> Result<EndState, SimulateError> {
     let x2 = scenario.trajectory.x2;
     let eq = sys.model.equilibrium(x2, scenario.controller.tension_sum)?;
     let pid = sys.pid.state_holding(eq.force).unwrap_or_default();
@@ -98,7 +115,13 @@ fn vertical_mode<M: CableModel>(
     let t = scenario.trajectory.t2 + 1.0;
     let jac = modal::closed_loop_jacobian(&mut sys, t, &y);
     let modes = modal::modes(&jac).map_err(SimulateError::Eigen)?;
-    modal::nearest_mode(&modes, eq15_at_end(scenario)).ok_or(SimulateError::NoMode)
+    let mode = modal::nearest_mode(&modes, eq15_at_end(scenario)).ok_or(SimulateError::NoMode)?;
+    let effector = sys.model.effector(&eq.state).position;
+    Ok(EndState {
+        mode,
+        equilibrium: eq,
+        effector,
+    })
 }
 
 /// Eq. 15 at x2 with T = ΣT/2 [rad/s] (paper: 20.41 rad/s).

@@ -5,6 +5,7 @@
 //!
 //! Errors are printed for a person and give a non-zero exit; a failed run keeps its output.
 
+mod figures;
 mod output;
 mod report;
 mod simulate;

@@ -1,0 +1,90 @@
+//! `cargo xtask report` on a short scenario into a temporary directory: every file exists, the
+//! PNGs decode at the right size, the SVGs parse, REPORT.md has a row per §8 quantity and model.
+
+use std::path::Path;
+use std::process::Command;
+
+const FIGURES: [&str; 5] = [
+    "fig5_position",
+    "fig6_error",
+    "fig7_spectrum",
+    "fig8_tensions",
+    "step5_reference",
+];
+
+/// The per-model quantities of MODELS.md §8 (the report's row names).
+const QUANTITIES: [&str; 14] = [
+    "T1 minimum",
+    "T1 maximum",
+    "T1 settled (mean over [4, 5] s)",
+    "T2 settled (mean over [4, 5] s)",
+    "T1(5 s), T2(5 s)",
+    "max \\|error\\| in the transition [0, 0.2] s",
+    "overshoot",
+    "max \\|error\\| over [1, 5] s",
+    "max \\|error\\| over [1.5, 5] s",
+    "z peak-to-peak over [1, 5] s",
+    "z refined spectral peak over [1, 5] s",
+    "error refined spectral peak over [1, 5] s",
+    "plain FFT peak of z over [0, 5] s",
+    "high-frequency content of the error spectrum",
+];
+
+fn report(dir: &Path) -> std::process::Output {
+    let scenario = dir.join("short.toml");
+    std::fs::write(&scenario, "[simulation]\nt_final = 1.2\nsample_period = 1e-4\n").unwrap();
+    Command::new(env!("CARGO_BIN_EXE_xtask"))
+        .args(["report", "--scenario"])
+        .arg(&scenario)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn report_writes_every_figure_table_and_file() {
+    let dir = std::env::temp_dir().join(format!("cdpr-report-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let output = report(&dir);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let out = dir.join("out");
+
+    for name in FIGURES {
+        let png = image::open(out.join(format!("{name}.png"))).unwrap();
+        assert_eq!((png.width(), png.height()), (1920, 1280), "{name}.png");
+        let svg = std::fs::read_to_string(out.join(format!("{name}.svg"))).unwrap();
+        let doc = roxmltree::Document::parse(&svg).unwrap_or_else(|e| panic!("{name}.svg: {e}"));
+        assert_eq!(doc.root_element().tag_name().name(), "svg");
+        assert!(svg.contains("<path") || svg.contains("<polyline"), "{name}.svg has curves");
+    }
+
+    let md = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    let models: Vec<String> = json["models"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["model"].as_str().unwrap().to_owned())
+        .collect();
+    assert!(models.contains(&"elastic".to_owned()) && models.contains(&"lumped".to_owned()), "{models:?}");
+    for model in &models {
+        for q in QUANTITIES {
+            let row = format!("| {q} | {model} |");
+            assert!(md.contains(&row), "REPORT.md lacks the row `{row}`");
+        }
+    }
+    assert!(md.contains("| eq. 15 at x = 0.6 | all |"));
+    for name in FIGURES {
+        assert!(md.contains(&format!("({name}.svg)")), "REPORT.md embeds {name}");
+    }
+    let leftovers: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with('.'))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
