@@ -158,7 +158,9 @@ pub fn spectrum(run: &Run, name: &str, dt: f64, w0: f64, w1: f64) -> Vec<(f64, f
 pub fn step5_lines(step5: &Step5) -> [Vec<(f64, f64)>; 3] {
     let span = step5.t2 - step5.t1;
     let (a, b) = (step5.t1 - 0.25 * span, step5.t2 + 0.25 * span);
-    let ts: Vec<f64> = (0..=MAX_POINTS).map(|k| a + (b - a) * k as f64 / MAX_POINTS as f64).collect();
+    let ts: Vec<f64> = (0..=MAX_POINTS)
+        .map(|k| a + (b - a) * k as f64 / MAX_POINTS as f64)
+        .collect();
     [
         ts.iter().map(|&t| (t, step5.position(t))).collect(),
         ts.iter().map(|&t| (t, step5.velocity(t))).collect(),
@@ -174,7 +176,8 @@ pub fn render(figure: &Figure, dir: &Path) -> Result<()> {
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         draw(&root, figure, 1.0).map_err(|e| anyhow!("drawing {}: {e}", figure.name))?;
-        root.present().map_err(|e| anyhow!("drawing {}: {e:?}", figure.name))?;
+        root.present()
+            .map_err(|e| anyhow!("drawing {}: {e:?}", figure.name))?;
     }
     write_atomic(&svg_path, |w| w.write_all(svg.as_bytes()))?;
 
@@ -194,7 +197,11 @@ pub fn render(figure: &Figure, dir: &Path) -> Result<()> {
     std::fs::rename(&tmp, &png_path).with_context(|| format!("writing {}", png_path.display()))
 }
 
-fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, figure: &Figure, scale: f64) -> Result<(), String>
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    figure: &Figure,
+    scale: f64,
+) -> Result<(), String>
 where
     DB::ErrorType: 'static,
 {
@@ -212,7 +219,9 @@ where
 }
 
 fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
-    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
     if !lo.is_finite() {
         return (0.0, 1.0);
     }
@@ -233,7 +242,11 @@ fn tick(v: f64) -> String {
 }
 
 fn power_label(v: &f64) -> String {
-    if (v - v.round()).abs() < 1e-9 { format!("1e{}", v.round() as i64) } else { String::new() }
+    if (v - v.round()).abs() < 1e-9 {
+        format!("1e{}", v.round() as i64)
+    } else {
+        String::new()
+    }
 }
 
 fn draw_panel<DB: DrawingBackend>(
@@ -243,9 +256,20 @@ fn draw_panel<DB: DrawingBackend>(
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let px = |v: f64| (v * scale).round() as u32;
     let tx = |x: f64| if panel.log_x { x.log10() } else { x };
-    let ty = |y: f64| if panel.log_y { y.abs().max(1e-300).log10() } else { y };
+    let ty = |y: f64| {
+        if panel.log_y {
+            y.abs().max(1e-300).log10()
+        } else {
+            y
+        }
+    };
     let valid = |p: &&(f64, f64)| (!panel.log_x || p.0 > 0.0) && (!panel.log_y || p.1 != 0.0);
-    let all = || panel.lines.iter().flat_map(|l| l.points.iter().filter(valid));
+    let all = || {
+        panel
+            .lines
+            .iter()
+            .flat_map(|l| l.points.iter().filter(valid))
+    };
     let (mut x0, mut x1) = bounds(all().map(|p| tx(p.0)));
     let (mut y0, mut y1) = bounds(all().map(|p| ty(p.1)));
     if panel.log_x {
@@ -266,14 +290,34 @@ fn draw_panel<DB: DrawingBackend>(
         .x_label_area_size(px(40.0))
         .y_label_area_size(px(80.0))
         .build_cartesian_2d(x0..x1, y0..y1)?;
-    let x_fmt = |v: &f64| if panel.log_x { power_label(v) } else { tick(*v) };
-    let y_fmt = |v: &f64| if panel.log_y { power_label(v) } else { tick(*v) };
+    let x_fmt = |v: &f64| {
+        if panel.log_x {
+            power_label(v)
+        } else {
+            tick(*v)
+        }
+    };
+    let y_fmt = |v: &f64| {
+        if panel.log_y {
+            power_label(v)
+        } else {
+            tick(*v)
+        }
+    };
     chart
         .configure_mesh()
         .x_desc(panel.x_label.as_str())
         .y_desc(panel.y_label.as_str())
-        .x_labels(if panel.log_x { (x1 - x0) as usize + 1 } else { 10 })
-        .y_labels(if panel.log_y { (y1 - y0) as usize + 1 } else { 8 })
+        .x_labels(if panel.log_x {
+            (x1 - x0) as usize + 1
+        } else {
+            10
+        })
+        .y_labels(if panel.log_y {
+            (y1 - y0) as usize + 1
+        } else {
+            8
+        })
         .x_label_formatter(&x_fmt)
         .y_label_formatter(&y_fmt)
         .label_style(label_font.clone())
@@ -291,14 +335,23 @@ fn draw_panel<DB: DrawingBackend>(
         chart.draw_series(std::iter::once(Text::new(
             format!(" {text}"),
             at,
-            ("sans-serif", px(12.0)).into_font().color(&RGBColor(80, 80, 80)),
+            ("sans-serif", px(12.0))
+                .into_font()
+                .color(&RGBColor(80, 80, 80)),
         )))?;
     }
     for line in &panel.lines {
         let style = line.color.stroke_width(stroke);
-        let pts: Vec<(f64, f64)> = line.points.iter().filter(valid).map(|p| (tx(p.0), ty(p.1))).collect();
+        let pts: Vec<(f64, f64)> = line
+            .points
+            .iter()
+            .filter(valid)
+            .map(|p| (tx(p.0), ty(p.1)))
+            .collect();
         let color = line.color;
-        let legend = move |(x, y): (i32, i32)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3));
+        let legend = move |(x, y): (i32, i32)| {
+            PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
+        };
         if line.dashed {
             chart
                 .draw_series(DashedLineSeries::new(pts, px(8.0), px(5.0), style))?

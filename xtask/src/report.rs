@@ -61,9 +61,11 @@ fn bars(kinds: &[ModelKind]) -> (MultiProgress, Vec<ProgressBar>) {
             }
             let bar = multi.add(ProgressBar::new(1000));
             bar.set_style(
-                ProgressStyle::with_template("{prefix:>8} [{bar:40}] {percent:>3}% {elapsed_precise}")
-                    .expect("static template")
-                    .progress_chars("=> "),
+                ProgressStyle::with_template(
+                    "{prefix:>8} [{bar:40}] {percent:>3}% {elapsed_precise}",
+                )
+                .expect("static template")
+                .progress_chars("=> "),
             );
             bar.set_prefix(k.name());
             bar
@@ -74,7 +76,8 @@ fn bars(kinds: &[ModelKind]) -> (MultiProgress, Vec<ProgressBar>) {
 
 /// Runs one model of the scenario; `None` if the model does not exist yet.
 fn run_model(scenario: &Scenario, bar: &ProgressBar) -> Result<Option<Outcome>> {
-    let run = match cdpr_verify::simulate(scenario, &mut |f| bar.set_position((f * 1000.0) as u64)) {
+    let run = match cdpr_verify::simulate(scenario, &mut |f| bar.set_position((f * 1000.0) as u64))
+    {
         Ok(run) => run,
         Err(SimulateError::ModelUnavailable(_)) => {
             bar.finish_and_clear();
@@ -109,7 +112,10 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
             .collect();
         handles
             .into_iter()
-            .map(|h| h.join().unwrap_or_else(|_| bail!("a model thread panicked")))
+            .map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| bail!("a model thread panicked"))
+            })
             .collect()
     });
     let mut outcomes = Vec::new();
@@ -187,7 +193,12 @@ fn lines(curves: &[Curve], f: impl Fn(&Run) -> Vec<(f64, f64)>) -> Vec<Line> {
 }
 
 /// Draws every figure; returns (file stem, caption) in report order.
-fn write_figures(base: &Scenario, outcomes: &[Outcome], eq15: f64, out: &Path) -> Result<Vec<(String, String)>> {
+fn write_figures(
+    base: &Scenario,
+    outcomes: &[Outcome],
+    eq15: f64,
+    out: &Path,
+) -> Result<Vec<(String, String)>> {
     let c = curves(outcomes);
     let t_end = base.simulation.t_final;
     let dt = base.simulation.sample_period;
@@ -283,7 +294,13 @@ fn write_figures(base: &Scenario, outcomes: &[Outcome], eq15: f64, out: &Path) -
         name: "fig8_tensions".into(),
         title: "Fig. 8: commanded cable tensions (T1 solid, T2 dashed)".into(),
         panels: vec![
-            panel("t [s]", "tension [N] (transition)", tensions(0.0, (2.0 * t2).min(t_end)), vec![], false),
+            panel(
+                "t [s]",
+                "tension [N] (transition)",
+                tensions(0.0, (2.0 * t2).min(t_end)),
+                vec![],
+                false,
+            ),
             panel(
                 "t [s]",
                 "tension [N] (settling)",
@@ -298,7 +315,14 @@ fn write_figures(base: &Scenario, outcomes: &[Outcome], eq15: f64, out: &Path) -
     });
     let [xs, vs, accs] = figures::step5_lines(&step5);
     let [ta, tb] = step5.max_acceleration_times();
-    let reference = |label: &str, points| vec![Line { label: label.into(), color: black, dashed: false, points }];
+    let reference = |label: &str, points| {
+        vec![Line {
+            label: label.into(),
+            color: black,
+            dashed: false,
+            points,
+        }]
+    };
     figures_out.push(Figure {
         name: "step5_reference".into(),
         title: "step5 reference (eq. 13) with its analytic maxima".into(),
@@ -308,7 +332,10 @@ fn write_figures(base: &Scenario, outcomes: &[Outcome], eq15: f64, out: &Path) -
                 "t [s]",
                 "v_ref [m/s]",
                 reference("v_ref", vs),
-                vec![Marker::Horizontal(step5.max_speed(), format!("v_max = {:.4} m/s", step5.max_speed()))],
+                vec![Marker::Horizontal(
+                    step5.max_speed(),
+                    format!("v_max = {:.4} m/s", step5.max_speed()),
+                )],
                 false,
             ),
             panel(
@@ -316,7 +343,10 @@ fn write_figures(base: &Scenario, outcomes: &[Outcome], eq15: f64, out: &Path) -
                 "a_ref [m/s²]",
                 reference("a_ref", accs),
                 vec![
-                    Marker::Horizontal(step5.max_acceleration(), format!("±{:.3} m/s²", step5.max_acceleration())),
+                    Marker::Horizontal(
+                        step5.max_acceleration(),
+                        format!("±{:.3} m/s²", step5.max_acceleration()),
+                    ),
                     Marker::Horizontal(-step5.max_acceleration(), String::new()),
                     Marker::Vertical(ta, format!("{ta:.4} s")),
                     Marker::Vertical(tb, format!("{tb:.4} s")),
@@ -344,8 +374,13 @@ fn git_revision() -> String {
     };
     match run(&["rev-parse", "--short=12", "HEAD"]) {
         Some(rev) => {
-            let dirty = run(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
-            if dirty { format!("{rev} (with uncommitted changes)") } else { rev }
+            let dirty = run(&["status", "--porcelain", "--untracked-files=no"])
+                .is_some_and(|s| !s.is_empty());
+            if dirty {
+                format!("{rev} (with uncommitted changes)")
+            } else {
+                rev
+            }
         }
         None => "unknown (not a git checkout)".into(),
     }
@@ -380,12 +415,19 @@ fn write_markdown(
              samples every {:e} s over {} s. Regenerate with `cargo xtask report`.\n",
             sim.rtol, sim.atol, sim.sample_period, sim.t_final
         )?;
-        writeln!(w, "**{passed} of {} checks of MODELS.md §8 pass.**", checks.len())?;
+        writeln!(
+            w,
+            "**{passed} of {} checks of MODELS.md §8 pass.**",
+            checks.len()
+        )?;
         if !skipped.is_empty() {
             writeln!(w, " Models not implemented yet: {}.", skipped.join(", "))?;
         }
         writeln!(w)?;
-        writeln!(w, "## MODELS.md §8: the paper's results, ours, the tolerance\n")?;
+        writeln!(
+            w,
+            "## MODELS.md §8: the paper's results, ours, the tolerance\n"
+        )?;
         writeln!(w, "| quantity | model | paper | ours | accept | pass |")?;
         writeln!(w, "|---|---|---|---|---|---|")?;
         for c in checks {
@@ -424,8 +466,14 @@ fn write_markdown(
             )?;
         }
 
-        writeln!(w, "\n## Static equilibria (MODELS.md §2 rule: effector x held, F0 unknown)\n")?;
-        writeln!(w, "| model | z at x1 [m] | F0 at x1 [N] | z at x2 [m] | F0 at x2 [N] |")?;
+        writeln!(
+            w,
+            "\n## Static equilibria (MODELS.md §2 rule: effector x held, F0 unknown)\n"
+        )?;
+        writeln!(
+            w,
+            "| model | z at x1 [m] | F0 at x1 [N] | z at x2 [m] | F0 at x2 [N] |"
+        )?;
         writeln!(w, "|---|---|---|---|---|")?;
         for o in outcomes {
             writeln!(
@@ -436,17 +484,28 @@ fn write_markdown(
         }
 
         writeln!(w, "\n## Solver statistics\n")?;
-        writeln!(w, "| model | RHS evaluations | accepted steps | rejected steps | pulley events | energy balance residual [J] |")?;
+        writeln!(
+            w,
+            "| model | RHS evaluations | accepted steps | rejected steps | pulley events | energy balance residual [J] |"
+        )?;
         writeln!(w, "|---|---|---|---|---|---|")?;
         for o in outcomes {
             let m = &o.metrics;
             writeln!(
                 w,
                 "| {} | {} | {} | {} | {} | {:.2e} |",
-                o.kind, m.rhs_evals, m.steps_accepted, m.steps_rejected, m.pulley_events, m.energy_residual_max
+                o.kind,
+                m.rhs_evals,
+                m.steps_accepted,
+                m.steps_rejected,
+                m.pulley_events,
+                m.energy_residual_max
             )?;
         }
-        writeln!(w, "\nWall times (this machine; the only numbers of this report that change between runs):\n")?;
+        writeln!(
+            w,
+            "\nWall times (this machine; the only numbers of this report that change between runs):\n"
+        )?;
         writeln!(w, "| model | wall time [s] |")?;
         writeln!(w, "|---|---|")?;
         for o in outcomes {
@@ -455,13 +514,25 @@ fn write_markdown(
 
         writeln!(w, "\n## Figures\n")?;
         for (name, caption) in figures {
-            writeln!(w, "### {caption}\n\n![{caption}]({name}.svg)\n\nPNG: [{name}.png]({name}.png)\n")?;
+            writeln!(
+                w,
+                "### {caption}\n\n![{caption}]({name}.svg)\n\nPNG: [{name}.png]({name}.png)\n"
+            )?;
         }
 
         writeln!(w, "## Software\n")?;
-        writeln!(w, "- cdpr-bench {} at git revision {}", env!("CARGO_PKG_VERSION"), git_revision())?;
+        writeln!(
+            w,
+            "- cdpr-bench {} at git revision {}",
+            env!("CARGO_PKG_VERSION"),
+            git_revision()
+        )?;
         writeln!(w, "- {}", rustc_version())?;
-        writeln!(w, "- integrator: our DOPRI5 (Hairer's dopri5.f, β = {})", sim.dopri_beta)?;
+        writeln!(
+            w,
+            "- integrator: our DOPRI5 (Hairer's dopri5.f, β = {})",
+            sim.dopri_beta
+        )?;
         Ok(())
     })
 }

@@ -32,7 +32,11 @@ const QUANTITIES: [&str; 14] = [
 
 fn report(dir: &Path) -> std::process::Output {
     let scenario = dir.join("short.toml");
-    std::fs::write(&scenario, "[simulation]\nt_final = 1.2\nsample_period = 1e-4\n").unwrap();
+    std::fs::write(
+        &scenario,
+        "[simulation]\nt_final = 1.2\nsample_period = 1e-4\n",
+    )
+    .unwrap();
     Command::new(env!("CARGO_BIN_EXE_xtask"))
         .args(["report", "--scenario"])
         .arg(&scenario)
@@ -48,7 +52,11 @@ fn report_writes_every_figure_table_and_file() {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let output = report(&dir);
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     let out = dir.join("out");
 
     for name in FIGURES {
@@ -57,7 +65,10 @@ fn report_writes_every_figure_table_and_file() {
         let svg = std::fs::read_to_string(out.join(format!("{name}.svg"))).unwrap();
         let doc = roxmltree::Document::parse(&svg).unwrap_or_else(|e| panic!("{name}.svg: {e}"));
         assert_eq!(doc.root_element().tag_name().name(), "svg");
-        assert!(svg.contains("<path") || svg.contains("<polyline"), "{name}.svg has curves");
+        assert!(
+            svg.contains("<path") || svg.contains("<polyline"),
+            "{name}.svg has curves"
+        );
     }
 
     let md = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
@@ -69,7 +80,10 @@ fn report_writes_every_figure_table_and_file() {
         .iter()
         .map(|m| m["model"].as_str().unwrap().to_owned())
         .collect();
-    assert!(models.contains(&"elastic".to_owned()) && models.contains(&"lumped".to_owned()), "{models:?}");
+    assert!(
+        models.contains(&"elastic".to_owned()) && models.contains(&"lumped".to_owned()),
+        "{models:?}"
+    );
     for model in &models {
         for q in QUANTITIES {
             let row = format!("| {q} | {model} |");
@@ -78,7 +92,10 @@ fn report_writes_every_figure_table_and_file() {
     }
     assert!(md.contains("| eq. 15 at x = 0.6 | all |"));
     for name in FIGURES {
-        assert!(md.contains(&format!("({name}.svg)")), "REPORT.md embeds {name}");
+        assert!(
+            md.contains(&format!("({name}.svg)")),
+            "REPORT.md embeds {name}"
+        );
     }
     let leftovers: Vec<_> = std::fs::read_dir(&out)
         .unwrap()
