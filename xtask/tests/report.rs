@@ -97,6 +97,28 @@ fn report_writes_every_figure_table_and_file() {
             "REPORT.md embeds {name}"
         );
     }
+    // Re-running gives identical numbers: metrics.json matches bit for bit once the wall times
+    // (the only machine-dependent numbers) are removed.
+    let strip = |mut v: serde_json::Value| {
+        for m in v["models"].as_array_mut().unwrap() {
+            m.as_object_mut().unwrap().remove("wall_s");
+        }
+        v
+    };
+    let first = strip(json.clone());
+    let again_dir = dir.join("again");
+    std::fs::create_dir_all(&again_dir).unwrap();
+    std::fs::copy(dir.join("short.toml"), again_dir.join("short.toml")).unwrap();
+    assert!(report(&again_dir).status.success());
+    let second: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(again_dir.join("out/metrics.json")).unwrap())
+            .unwrap();
+    assert_eq!(first, strip(second), "a second run changed the numbers");
+    for name in FIGURES {
+        let a = std::fs::read(out.join(format!("{name}.svg"))).unwrap();
+        let b = std::fs::read(again_dir.join(format!("out/{name}.svg"))).unwrap();
+        assert!(a == b, "{name}.svg differs between runs");
+    }
     let leftovers: Vec<_> = std::fs::read_dir(&out)
         .unwrap()
         .filter_map(|e| e.ok())
