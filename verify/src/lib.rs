@@ -12,6 +12,7 @@ use cdpr_core::model::{CableModel, Equilibrium, ModelError};
 use cdpr_core::scenario::{ModelKind, Scenario};
 use cdpr_core::trajectory::Step5;
 use cdpr_elastic::{Elastic, eq15_frequency};
+use cdpr_fe::Fe;
 use cdpr_lumped::Lumped;
 
 pub mod acceptance;
@@ -20,7 +21,7 @@ pub mod irvine;
 /// Why a scenario could not be simulated or analysed.
 #[derive(Debug, thiserror::Error)]
 pub enum SimulateError {
-    #[error("model `{0}` is not implemented yet (available: elastic, lumped)")]
+    #[error("model `{0}` is not implemented yet (available: elastic, lumped, fe)")]
     ModelUnavailable(ModelKind),
     #[error(transparent)]
     Run(#[from] Box<RunFailure>),
@@ -36,6 +37,7 @@ pub enum SimulateError {
 pub enum AnyModel {
     Elastic(Elastic),
     Lumped(Box<Lumped>),
+    Fe(Box<Fe>),
 }
 
 impl AnyModel {
@@ -44,7 +46,7 @@ impl AnyModel {
         match scenario.model.kind {
             ModelKind::Elastic => Ok(AnyModel::Elastic(Elastic::new(scenario))),
             ModelKind::Lumped => Ok(AnyModel::Lumped(Box::new(Lumped::new(scenario)?))),
-            kind => Err(SimulateError::ModelUnavailable(kind)),
+            ModelKind::Fe => Ok(AnyModel::Fe(Box::new(Fe::new(scenario)?))),
         }
     }
 }
@@ -59,6 +61,11 @@ pub fn simulate(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Ru
             progress,
         )?),
         AnyModel::Lumped(m) => Ok(run_loop(
+            &mut ClosedLoop::new(*m, scenario),
+            &opts,
+            progress,
+        )?),
+        AnyModel::Fe(m) => Ok(run_loop(
             &mut ClosedLoop::new(*m, scenario),
             &opts,
             progress,
@@ -98,6 +105,7 @@ pub fn end_state(scenario: &Scenario) -> Result<EndState, SimulateError> {
     match AnyModel::new(scenario)? {
         AnyModel::Elastic(m) => end_state_of(ClosedLoop::new(m, scenario), scenario),
         AnyModel::Lumped(m) => end_state_of(ClosedLoop::new(*m, scenario), scenario),
+        AnyModel::Fe(m) => end_state_of(ClosedLoop::new(*m, scenario), scenario),
     }
 }
 

@@ -98,10 +98,13 @@ fn slack_cable_stops_the_run_with_time_and_cable() {
     );
 }
 
+/// A model parameter outside the model's domain is a clear error naming the key (the FE model
+/// does not implement the optional axial damping of MODELS.md FE.5.7).
 #[test]
-fn unavailable_models_answer_with_a_clear_error() {
-    let scenario = Scenario::from_toml_str("[model]\nkind = \"fe\"").unwrap();
+fn unsupported_model_parameters_answer_with_a_clear_error() {
+    let scenario =
+        Scenario::from_toml_str("[model]\nkind = \"fe\"\n[cable]\naxial_damping = 0.5").unwrap();
     let err = simulate(&scenario, &mut |_| {}).unwrap_err();
-    assert!(matches!(err, SimulateError::ModelUnavailable(_)));
-    assert!(err.to_string().contains("`fe` is not implemented"), "{err}");
+    assert!(matches!(err, SimulateError::Model(_)), "{err:?}");
+    assert!(err.to_string().contains("cable.axial_damping"), "{err}");
 }

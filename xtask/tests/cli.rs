@@ -100,12 +100,9 @@ fn bad_scenario_is_reported_with_key_and_range() {
 }
 
 #[test]
-fn unknown_model_and_unimplemented_model_are_clear_errors() {
+fn unknown_models_are_clear_errors() {
     let dir = temp_dir("model");
-    for (model, expect) in [
-        ("rigid", "unknown model `rigid`"),
-        ("fe", "not implemented"),
-    ] {
+    for (model, expect) in [("rigid", "unknown model `rigid`"), ("", "unknown model ``")] {
         let output = xtask()
             .args(["simulate", "--model", model, "--out"])
             .arg(dir.join("out"))

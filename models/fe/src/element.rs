@@ -1,0 +1,160 @@
+//! The one variable-length element of MODELS.md FE.3–FE.5.3: two nodes a, b with convective
+//! weights w_a, w_b and unstrained length h(l), h' = dh/dl. A free element of the span has
+//! h = l/N, h' = 1/N, w_k = 1 − k/N; the stored element (reel end R → pulley A) has h = L0 − l,
+//! h' = −1, w_R = 0, w_A = 1. Both kinds are this same kernel, so the stored element cannot drift
+//! from the span's physics.
+//!
+//! Kinematics (FE.3): v(η) = (1 − η) a + η b + l' w(η) Δ/h, Δ = r_b − r_a, w linear in η. The
+//! kinetic energy is T_e = ½ μ h (c1|a|² + 2c2 a·b + c1|b|²) + μ l'(α a + β b)·Δ + ½ μ γ l'²|Δ|²/h
+//! (FE.4), with the coefficients of [`MassCoefficients`].
+
+use cdpr_core::scenario::FeMass;
+use nalgebra::Vector2;
+
+/// Element mass coefficients c1, c2, α, β, γ of MODELS.md FE.4 for weights (w_a, w_b).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MassCoefficients {
+    pub c1: f64,
+    pub c2: f64,
+    pub alpha: f64,
+    pub beta: f64,
+    pub gamma: f64,
+}
+
+impl MassCoefficients {
+    /// Consistent mass (the exact integral of the linear ansatz) or lumped mass (nodal,
+    /// trapezoidal quadrature of the kinetic energy), FE.4's table.
+    pub fn new(mass: FeMass, wa: f64, wb: f64) -> Self {
+        match mass {
+            FeMass::Consistent => Self {
+                c1: 1.0 / 3.0,
+                c2: 1.0 / 6.0,
+                alpha: wa / 3.0 + wb / 6.0,
+                beta: wa / 6.0 + wb / 3.0,
+                gamma: (wa * wa + wa * wb + wb * wb) / 3.0,
+            },
+            FeMass::Lumped => Self {
+                c1: 0.5,
+                c2: 0.0,
+                alpha: 0.5 * wa,
+                beta: 0.5 * wb,
+                gamma: 0.5 * (wa * wa + wb * wb),
+            },
+        }
+    }
+}
+
+/// Cable material per unit unstrained length.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Material {
+    /// Axial stiffness EA [N].
+    pub ea: f64,
+    /// Mass per unstrained length μ [kg/m].
+    pub mu: f64,
+    /// Gravity g [m/s²] along −z.
+    pub gravity: f64,
+}
+
+/// One element's configuration: node positions [m] and velocities [m/s], the span's l' [m/s],
+/// the element's unstrained length h [m] and h' = dh/dl.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElementState {
+    pub ra: Vector2<f64>,
+    pub rb: Vector2<f64>,
+    pub va: Vector2<f64>,
+    pub vb: Vector2<f64>,
+    pub l_rate: f64,
+    pub h: f64,
+    pub h_prime: f64,
+}
+
+/// What an element adds to M and F (FE.5.3), in its local unknowns (r_a, r_b, l).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElementTerms {
+    /// μ h c1: the r_a r_a and r_b r_b blocks (times I2) [kg].
+    pub m_diag: f64,
+    /// μ h c2: the r_a r_b block (times I2) [kg].
+    pub m_off: f64,
+    /// μ α Δ, μ β Δ: the r_a l and r_b l columns [kg].
+    pub m_al: Vector2<f64>,
+    pub m_bl: Vector2<f64>,
+    /// μ γ |Δ|²/h: the l l entry [kg].
+    pub m_ll: f64,
+    /// Generalised forces F_a, F_b [N] and F_l [N] (FE.5.3), gravity included.
+    pub fa: Vector2<f64>,
+    pub fb: Vector2<f64>,
+    pub fl: f64,
+}
+
+/// Element strain ε = |Δ|/h − 1 and tension N = EA max(ε, 0) (FE.2, FE.1.4: tension only).
+#[inline]
+pub fn tension(ea: f64, length: f64, h: f64) -> (f64, f64) {
+    let strain = length / h - 1.0;
+    (strain, ea * strain.max(0.0))
+}
+
+/// M_e and F_e of MODELS.md FE.5.3 for one element.
+#[inline]
+pub fn terms(mat: &Material, k: &MassCoefficients, s: &ElementState) -> ElementTerms {
+    let mu = mat.mu;
+    let (h, ld) = (s.h, s.l_rate);
+    let (a, b) = (s.va, s.vb);
+    let delta = s.rb - s.ra;
+    let len2 = delta.norm_squared();
+    let len = len2.sqrt();
+    let (strain, n) = tension(mat.ea, len, h);
+    // N t with t = Δ/|Δ|: the pull on node a towards b.
+    let pull = delta * (n / len);
+    let h_rate = s.h_prime * ld;
+    let delta_rate = b - a;
+    let inv_h = 1.0 / h;
+    let flux = a * k.alpha + b * k.beta;
+    // G = μ l'(α a + β b) + μ γ l'² Δ/h.
+    let g = (flux * ld + delta * (k.gamma * ld * ld * inv_h)) * mu;
+    let half_weight = 0.5 * mu * mat.gravity * h;
+    let fa = pull
+        - (a * k.c1 + b * k.c2) * (mu * h_rate)
+        - delta_rate * (mu * k.alpha * ld)
+        - g
+        - Vector2::new(0.0, half_weight);
+    let fb = -pull - (a * k.c2 + b * k.c1) * (mu * h_rate) - delta_rate * (mu * k.beta * ld) + g
+        - Vector2::new(0.0, half_weight);
+    let kinetic_density =
+        0.5 * mu * (k.c1 * (a.norm_squared() + b.norm_squared()) + 2.0 * k.c2 * a.dot(&b));
+    let ld2_len2_h2 = ld * ld * len2 * inv_h * inv_h;
+    let fl = -mu * flux.dot(&delta_rate)
+        - mu * k.gamma
+            * (2.0 * ld * delta.dot(&delta_rate) * inv_h - ld * h_rate * len2 * inv_h * inv_h)
+        + s.h_prime
+            * (kinetic_density - 0.5 * mu * k.gamma * ld2_len2_h2
+                + n * (1.0 + 0.5 * strain.max(0.0))
+                - mu * mat.gravity * 0.5 * (s.ra.y + s.rb.y));
+    ElementTerms {
+        m_diag: mu * h * k.c1,
+        m_off: mu * h * k.c2,
+        m_al: delta * (mu * k.alpha),
+        m_bl: delta * (mu * k.beta),
+        m_ll: mu * k.gamma * len2 * inv_h,
+        fa,
+        fb,
+        fl,
+    }
+}
+
+/// Element energies of MODELS.md FE.4: (kinetic T_e, strain ½ EA h max(ε,0)², gravity
+/// μ g h (z_a + z_b)/2) [J].
+pub fn energies(mat: &Material, k: &MassCoefficients, s: &ElementState) -> (f64, f64, f64) {
+    let mu = mat.mu;
+    let (h, ld) = (s.h, s.l_rate);
+    let (a, b) = (s.va, s.vb);
+    let delta = s.rb - s.ra;
+    let len2 = delta.norm_squared();
+    let kinetic =
+        0.5 * mu * h * (k.c1 * (a.norm_squared() + b.norm_squared()) + 2.0 * k.c2 * a.dot(&b))
+            + mu * ld * (a * k.alpha + b * k.beta).dot(&delta)
+            + 0.5 * mu * k.gamma * ld * ld * len2 / h;
+    let strain = (len2.sqrt() / h - 1.0).max(0.0);
+    let elastic = 0.5 * mat.ea * h * strain * strain;
+    let gravity = mu * mat.gravity * h * 0.5 * (s.ra.y + s.rb.y);
+    (kinetic, elastic, gravity)
+}

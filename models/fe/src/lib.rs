@@ -1,0 +1,499 @@
+//! # cdpr-fe: variable-length finite-element cables (paper §2.3, MODELS.md §5)
+//!
+//! Each cable is one closed material system (FE.1): the stored part on the line z = 0 from the reel
+//! end R_i to the pulley A_i, and the free span from A_i to the effector P. The span is N two-node
+//! elements of equal unstrained length h = l_i/N whose nodes sit at fixed fractions ξ_k = k/N of
+//! the span; the span's unstrained length l_i is itself a generalised coordinate, so material flows
+//! through the nodes at the convective speed l_i'(1 − ξ_k) (FE.3). The stored cable is one more
+//! element of the same kind ([`element`]), of unstrained length L0 − l_i, whose reel end R_i sits at
+//! distance ρ_i from the pulley; the commanded tension T_i pulls R_i away from the pulley (Q_ρ = T_i).
+//! Nothing is prescribed kinematically: Lagrange's equations of the ansatz contain every mass-flux
+//! term, so dE/dt = T_1 ρ_1' + T_2 ρ_2' exactly (FE.7) and the runner's `e_residual` audits it.
+//!
+//! Generalised coordinates (FE.5.1) in the chain order of FE.5.5, as structure-of-arrays:
+//! `q = [x of the 2N − 1 chain nodes | z of the chain nodes | l1, ρ1, l2, ρ2]` with the chain
+//! cable 1 nodes 1…N−1, P, cable 2 nodes N−1…1; n = 4(N − 1) + 6. The state is (q, q'), 2n long.
+//! The rigid-stored variant (FE.1.3) drops ρ_i: the border is (l1, l2), n = 4(N − 1) + 4.
+//!
+//! Per right-hand side: assemble M(q) and F(q, q', T) element by element ([`element::terms`]), then
+//! the O(N) block solve of FE.5.5 ([`solve::ChainSystem`]); nothing is allocated.
+
+pub mod chain;
+pub mod element;
+pub mod solve;
+mod statics;
+
+use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError};
+use cdpr_core::scenario::{FeMass, FeStored, Scenario};
+use element::{ElementState, MassCoefficients, Material};
+use nalgebra::Vector2;
+use solve::ChainSystem;
+
+/// Direction from each pulley towards its reel, e_out,i (MODELS.md FE.2).
+pub const E_OUT: [f64; 2] = [-1.0, 1.0];
+
+/// The two-cable robot with variable-length FE cables.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fe {
+    /// Pulley distance d [m]: A1 = (0, 0), A2 = (d, 0).
+    pub anchor_distance: f64,
+    /// Effector mass M [kg].
+    pub effector_mass: f64,
+    /// Free-span elements per cable N.
+    pub elements: usize,
+    /// Total unstrained length per cable L0 (stored + free) [m].
+    pub modelled_length: f64,
+    /// EA [N], μ [kg/m], g [m/s²].
+    pub material: Material,
+    /// Consistent (reference) or lumped mass (FE.1.5).
+    pub mass: FeMass,
+    /// Elastic stored element (reference) or rigid stored cable (FE.1.3).
+    pub stored: FeStored,
+    /// Mass coefficients of the free elements e = 1…N (index e − 1).
+    coefficients: Vec<MassCoefficients>,
+    /// Mass coefficients of the stored element (w_R = 0, w_A = 1).
+    stored_coefficients: MassCoefficients,
+    /// Border position of l_1, l_2 (0, 2 with ρ_i after each; 0, 1 for the rigid stored cable).
+    border_l: [usize; 2],
+    /// Border size: 4 or 2.
+    border: usize,
+    /// Assembled M, F and the solve's scratch (allocated once; taken out while assembling).
+    system: ChainSystem,
+}
+
+impl Fe {
+    /// The model with the scenario's robot, cable, element count and variants.
+    pub fn new(scenario: &Scenario) -> Result<Self, ModelError> {
+        let n = scenario.model.elements();
+        if n < 1 {
+            return Err(ModelError::Parameter {
+                name: "model.elements",
+                value: n as f64,
+                allowed: "≥ 1 for the FE model".into(),
+            });
+        }
+        let cable = &scenario.cable;
+        if cable.axial_damping != 0.0 {
+            return Err(ModelError::Parameter {
+                name: "cable.axial_damping",
+                value: cable.axial_damping,
+                allowed: "0 for the FE model (the Kelvin–Voigt terms of MODELS.md FE.5.7 are not \
+                          implemented)"
+                    .into(),
+            });
+        }
+        let mass = scenario.model.fe_mass;
+        let stored = scenario.model.fe_stored;
+        let coefficients = (1..=n)
+            .map(|e| {
+                let w = |k: usize| 1.0 - k as f64 / n as f64;
+                MassCoefficients::new(mass, w(e - 1), w(e))
+            })
+            .collect();
+        let nodes = 2 * n - 1;
+        let (border, l_index) = match stored {
+            FeStored::Elastic => (4, [0, 2]),
+            FeStored::Rigid => (2, [0, 1]),
+        };
+        Ok(Self {
+            anchor_distance: scenario.robot.anchor_distance,
+            effector_mass: scenario.robot.effector_mass,
+            elements: n,
+            modelled_length: cable.modelled_length,
+            material: Material {
+                ea: cable.axial_stiffness(),
+                mu: cable.mass_per_length(),
+                gravity: scenario.robot.gravity,
+            },
+            mass,
+            stored,
+            coefficients,
+            stored_coefficients: MassCoefficients::new(mass, 0.0, 1.0),
+            border_l: l_index,
+            border,
+            system: ChainSystem::new(nodes, border, l_index),
+        })
+    }
+
+    /// Chain nodes 2N − 1 (cable 1 nodes 1…N−1, P, cable 2 nodes N−1…1).
+    pub fn chain_nodes(&self) -> usize {
+        2 * self.elements - 1
+    }
+
+    /// Border unknowns: 4 (l1, ρ1, l2, ρ2) or 2 (l1, l2, rigid stored cable).
+    pub fn border_len(&self) -> usize {
+        self.border
+    }
+
+    /// Number of generalised coordinates n (FE.5.1).
+    pub fn positions_len(&self) -> usize {
+        2 * self.chain_nodes() + self.border_len()
+    }
+
+    /// Chain index of node k (1…N) of `cable` (0 or 1); None for the pulley node k = 0.
+    #[inline]
+    pub fn chain_index(&self, cable: usize, k: usize) -> Option<usize> {
+        let n = self.elements;
+        match (cable, k) {
+            (_, 0) => None,
+            (0, k) => Some(k - 1),
+            (_, k) => Some(2 * n - 1 - k),
+        }
+    }
+
+    /// Index in q of the x (`axis` 0) or z (`axis` 1) coordinate of chain node `j`.
+    #[inline]
+    pub fn node_coordinate(&self, j: usize, axis: usize) -> usize {
+        axis * self.chain_nodes() + j
+    }
+
+    /// Index in q of the effector's x (its z is at `+ chain_nodes()`).
+    pub fn effector_index(&self) -> usize {
+        self.elements - 1
+    }
+
+    /// Index in q of l_i (cable 0 or 1).
+    #[inline]
+    pub fn l_index(&self, cable: usize) -> usize {
+        2 * self.chain_nodes() + self.border_l[cable]
+    }
+
+    /// Index in q of ρ_i; None for the rigid stored cable.
+    #[inline]
+    pub fn rho_index(&self, cable: usize) -> Option<usize> {
+        match self.stored {
+            FeStored::Elastic => Some(2 * self.chain_nodes() + 2 * cable + 1),
+            FeStored::Rigid => None,
+        }
+    }
+
+    /// Pulley point A_i [m].
+    pub fn pulley(&self, cable: usize) -> Vector2<f64> {
+        Vector2::new(cable as f64 * self.anchor_distance, 0.0)
+    }
+
+    /// Position and velocity of node k (0…N) of `cable` in state `y` = (q, q') [m, m/s]; node 0 is
+    /// the fixed pulley point.
+    #[inline]
+    pub fn node(&self, y: &[f64], cable: usize, k: usize) -> (Vector2<f64>, Vector2<f64>) {
+        match self.chain_index(cable, k) {
+            None => (self.pulley(cable), Vector2::zeros()),
+            Some(j) => {
+                let (np, nn) = (self.positions_len(), self.chain_nodes());
+                (
+                    Vector2::new(y[j], y[nn + j]),
+                    Vector2::new(y[np + j], y[np + nn + j]),
+                )
+            }
+        }
+    }
+
+    /// State of element e (1…N) of `cable`.
+    #[inline]
+    fn free_element(&self, y: &[f64], cable: usize, e: usize) -> ElementState {
+        let np = self.positions_len();
+        let li = self.l_index(cable);
+        let (ra, va) = self.node(y, cable, e - 1);
+        let (rb, vb) = self.node(y, cable, e);
+        let n = self.elements as f64;
+        ElementState {
+            ra,
+            rb,
+            va,
+            vb,
+            l_rate: y[np + li],
+            h: y[li] / n,
+            h_prime: 1.0 / n,
+        }
+    }
+
+    /// State of the elastic stored element of `cable` (R = A + ρ e_out → A), if it exists.
+    #[inline]
+    fn stored_element(&self, y: &[f64], cable: usize) -> Option<ElementState> {
+        let ri = self.rho_index(cable)?;
+        let np = self.positions_len();
+        let li = self.l_index(cable);
+        let e_out = Vector2::new(E_OUT[cable], 0.0);
+        let a = self.pulley(cable);
+        Some(ElementState {
+            ra: a + e_out * y[ri],
+            rb: a,
+            va: e_out * y[np + ri],
+            vb: Vector2::zeros(),
+            l_rate: y[np + li],
+            h: self.modelled_length - y[li],
+            h_prime: -1.0,
+        })
+    }
+
+    /// Assembles M(q) and F(q, q', T) (FE.5.3) into the block system of FE.5.5.
+    fn assemble(&mut self, y: &[f64], tensions: [f64; 2]) {
+        let mut sys = std::mem::take(&mut self.system);
+        sys.clear();
+        let n = self.elements;
+        let mat = self.material;
+        for cable in 0..2 {
+            let lb = sys.l_index[cable];
+            let col = 2 + 2 * cable;
+            for e in 1..=n {
+                let s = self.free_element(y, cable, e);
+                let t = element::terms(&mat, &self.coefficients[e - 1], &s);
+                let ja = self.chain_index(cable, e - 1);
+                let jb = self.chain_index(cable, e).expect("node e ≥ 1 is free");
+                if let Some(ja) = ja {
+                    sys.diag[ja] += t.m_diag;
+                    sys.off[ja.min(jb)] += t.m_off;
+                    let r = &mut sys.rhs[ja];
+                    r[0] += t.fa.x;
+                    r[1] += t.fa.y;
+                    r[col] += t.m_al.x;
+                    r[col + 1] += t.m_al.y;
+                }
+                sys.diag[jb] += t.m_diag;
+                let r = &mut sys.rhs[jb];
+                r[0] += t.fb.x;
+                r[1] += t.fb.y;
+                r[col] += t.m_bl.x;
+                r[col + 1] += t.m_bl.y;
+                sys.d[lb][lb] += t.m_ll;
+                sys.f_border[lb] += t.fl;
+            }
+            let li = self.l_index(cable);
+            match self.stored_element(y, cable) {
+                Some(s) => {
+                    // Row ρ: the projection of the kernel's R-node terms on e_out (R = A + ρ e_out),
+                    // plus the commanded tension pulling R away from the pulley (FE.5.3).
+                    let t = element::terms(&mat, &self.stored_coefficients, &s);
+                    let e_out = Vector2::new(E_OUT[cable], 0.0);
+                    let rb = lb + 1;
+                    sys.d[rb][rb] += t.m_diag;
+                    let m_rho_l = t.m_al.dot(&e_out);
+                    sys.d[rb][lb] += m_rho_l;
+                    sys.d[lb][rb] += m_rho_l;
+                    sys.d[lb][lb] += t.m_ll;
+                    sys.f_border[rb] += t.fa.dot(&e_out) + tensions[cable];
+                    sys.f_border[lb] += t.fl;
+                }
+                None => {
+                    // Rigid stored cable: T_s = ½ μ (L0 − l) l'², virtual work −T_i δl_i.
+                    let np = self.positions_len();
+                    let ld = y[np + li];
+                    sys.d[lb][lb] += mat.mu * (self.modelled_length - y[li]);
+                    sys.f_border[lb] += 0.5 * mat.mu * ld * ld - tensions[cable];
+                }
+            }
+        }
+        let p = self.effector_index();
+        sys.diag[p] += self.effector_mass;
+        sys.rhs[p][1] -= self.effector_mass * mat.gravity;
+        self.system = sys;
+    }
+
+    /// Generalised accelerations q'' = M⁻¹F for state `y` and tensions [T1, T2] into `qdd`
+    /// (length n) [m/s²]; false if M is not positive definite (the state left the model's
+    /// domain, FE.9.4).
+    pub fn accelerations(&mut self, y: &[f64], tensions: [f64; 2], qdd: &mut [f64]) -> bool {
+        self.assemble(y, tensions);
+        self.solve_assembled(qdd)
+    }
+
+    /// The solve of FE.5.5 on the system just assembled (it consumes the assembly).
+    fn solve_assembled(&mut self, qdd: &mut [f64]) -> bool {
+        let nn = self.chain_nodes();
+        let (ax, rest) = qdd.split_at_mut(nn);
+        let (az, border) = rest.split_at_mut(nn);
+        self.system.solve(ax, az, border)
+    }
+
+    /// Assembles only (for benches): M and F of `y` into the internal system.
+    pub fn assemble_only(&mut self, y: &[f64], tensions: [f64; 2]) {
+        self.assemble(y, tensions);
+    }
+
+    /// The dense mass matrix M(q) (n × n, FE.5.3) of state `y` (allocates; tests and analysis).
+    pub fn mass_matrix(&mut self, y: &[f64]) -> nalgebra::DMatrix<f64> {
+        self.assemble(y, [0.0, 0.0]);
+        let (nn, np) = (self.chain_nodes(), self.positions_len());
+        let s = &self.system;
+        let mut m = nalgebra::DMatrix::zeros(np, np);
+        for axis in 0..2 {
+            for j in 0..nn {
+                let i = axis * nn + j;
+                m[(i, i)] = s.diag[j];
+                if j + 1 < nn {
+                    m[(i, i + 1)] = s.off[j];
+                    m[(i + 1, i)] = s.off[j];
+                }
+                for cable in 0..2 {
+                    let c = s.rhs[j][2 + 2 * cable + axis];
+                    let l = 2 * nn + s.l_index[cable];
+                    m[(i, l)] = c;
+                    m[(l, i)] = c;
+                }
+            }
+        }
+        for a in 0..s.border {
+            for b in 0..s.border {
+                m[(2 * nn + a, 2 * nn + b)] = s.d[a][b];
+            }
+        }
+        m
+    }
+
+    /// The generalised forces F(q, q', T) (n, FE.5.2) of state `y` (allocates; tests).
+    pub fn force_vector(&mut self, y: &[f64], tensions: [f64; 2]) -> nalgebra::DVector<f64> {
+        self.assemble(y, tensions);
+        let (nn, np) = (self.chain_nodes(), self.positions_len());
+        let s = &self.system;
+        let mut f = nalgebra::DVector::zeros(np);
+        for j in 0..nn {
+            f[j] = s.rhs[j][0];
+            f[nn + j] = s.rhs[j][1];
+        }
+        for b in 0..s.border {
+            f[2 * nn + b] = s.f_border[b];
+        }
+        f
+    }
+
+    /// Strain and tension (ε, N_e) of element e (1…N) of `cable` [–, N].
+    pub fn element_tension(&self, y: &[f64], cable: usize, e: usize) -> (f64, f64) {
+        let s = self.free_element(y, cable, e);
+        element::tension(self.material.ea, (s.rb - s.ra).norm(), s.h)
+    }
+
+    /// Strain and tension of the stored element of `cable` (None for the rigid stored cable).
+    pub fn stored_tension(&self, y: &[f64], cable: usize) -> Option<(f64, f64)> {
+        let s = self.stored_element(y, cable)?;
+        Some(element::tension(
+            self.material.ea,
+            (s.rb - s.ra).norm(),
+            s.h,
+        ))
+    }
+
+    /// Unstrained free length l_i [m].
+    pub fn free_length(&self, y: &[f64], cable: usize) -> f64 {
+        y[self.l_index(cable)]
+    }
+
+    /// Stored length: ρ_i (distance pulley → reel end) for the elastic stored element, the
+    /// unstrained L0 − l_i for the rigid one [m].
+    pub fn stored_length(&self, y: &[f64], cable: usize) -> f64 {
+        match self.rho_index(cable) {
+            Some(r) => y[r],
+            None => self.modelled_length - y[self.l_index(cable)],
+        }
+    }
+
+    /// Total cable mass 2 μ L0 [kg] (constant: the span and stored parts exchange material).
+    pub fn cable_mass(&self) -> f64 {
+        2.0 * self.material.mu * self.modelled_length
+    }
+}
+
+impl CableModel for Fe {
+    fn name(&self) -> &'static str {
+        "fe"
+    }
+
+    fn state_len(&self) -> usize {
+        2 * self.positions_len()
+    }
+
+    fn equilibrium(
+        &mut self,
+        effector_x: f64,
+        tension_sum: f64,
+    ) -> Result<Equilibrium, ModelError> {
+        statics::equilibrium(self, effector_x, tension_sum)
+    }
+
+    fn rhs(&mut self, _t: f64, y: &[f64], tensions: [f64; 2], rate: &mut [f64]) {
+        let np = self.positions_len();
+        let (dq, dv) = rate.split_at_mut(np);
+        dq.copy_from_slice(&y[np..]);
+        if !self.accelerations(y, tensions, dv) {
+            // M is not positive definite (an element or the stored cable collapsed): no motion is
+            // defined; NaN makes the integrator stop with a non-finite state.
+            dv.fill(f64::NAN);
+        }
+    }
+
+    fn effector(&self, y: &[f64]) -> Effector {
+        let (position, velocity) = self.node(y, 0, self.elements);
+        Effector { position, velocity }
+    }
+
+    /// dE/dt = Σ T_i ρ_i' (FE.7): the reel end moving away from the pulley takes cable in. Rigid
+    /// stored cable: −l_i'.
+    fn reel_speeds(&self, y: &[f64]) -> [f64; 2] {
+        let np = self.positions_len();
+        [0, 1].map(|c| match self.rho_index(c) {
+            Some(r) => y[np + r],
+            None => -y[np + self.l_index(c)],
+        })
+    }
+
+    fn energy(&self, y: &[f64]) -> Energy {
+        let mat = &self.material;
+        let np = self.positions_len();
+        let mut e = Energy::default();
+        for cable in 0..2 {
+            for el in 1..=self.elements {
+                let s = self.free_element(y, cable, el);
+                let (k, u, g) = element::energies(mat, &self.coefficients[el - 1], &s);
+                e.kinetic += k;
+                e.elastic += u;
+                e.gravity += g;
+            }
+            match self.stored_element(y, cable) {
+                Some(s) => {
+                    let (k, u, _) = element::energies(mat, &self.stored_coefficients, &s);
+                    e.kinetic += k;
+                    e.elastic += u;
+                }
+                None => {
+                    let li = self.l_index(cable);
+                    let ld = y[np + li];
+                    e.kinetic += 0.5 * mat.mu * (self.modelled_length - y[li]) * ld * ld;
+                }
+            }
+        }
+        let (p, v) = self.node(y, 0, self.elements);
+        e.kinetic += 0.5 * self.effector_mass * v.norm_squared();
+        e.gravity += self.effector_mass * mat.gravity * p.y;
+        e
+    }
+
+    fn channel_names(&self) -> Vec<String> {
+        [
+            "T_effector_1",
+            "T_effector_2",
+            "T_pulley_1",
+            "T_pulley_2",
+            "l_free_1",
+            "l_free_2",
+            "stored_1",
+            "stored_2",
+        ]
+        .map(String::from)
+        .to_vec()
+    }
+
+    /// Element tensions N_N (at the effector) and N_1 (at the pulley) [N], free unstrained lengths
+    /// l_i [m], stored lengths ρ_i [m].
+    fn channels(&self, y: &[f64], _tensions: [f64; 2], out: &mut [f64]) {
+        let n = self.elements;
+        out.copy_from_slice(&[
+            self.element_tension(y, 0, n).1,
+            self.element_tension(y, 1, n).1,
+            self.element_tension(y, 0, 1).1,
+            self.element_tension(y, 1, 1).1,
+            self.free_length(y, 0),
+            self.free_length(y, 1),
+            self.stored_length(y, 0),
+            self.stored_length(y, 1),
+        ]);
+    }
+}
