@@ -205,6 +205,13 @@ pub fn model_checks(r: &ModelResult) -> Vec<Check> {
     rows
 }
 
+/// The whole table: each model's rows, then the scenario and cross-model rows.
+pub fn table(eq15: f64, results: &[ModelResult]) -> Vec<Check> {
+    let mut rows: Vec<Check> = results.iter().flat_map(model_checks).collect();
+    rows.extend(scenario_checks(eq15, results));
+    rows
+}
+
 /// Rows about the scenario and across models (those whose models are present).
 pub fn scenario_checks(eq15: f64, results: &[ModelResult]) -> Vec<Check> {
     let mut rows = vec![check(

@@ -21,8 +21,6 @@ pub mod irvine;
 /// Why a scenario could not be simulated or analysed.
 #[derive(Debug, thiserror::Error)]
 pub enum SimulateError {
-    #[error("model `{0}` is not implemented yet (available: elastic, lumped, fe)")]
-    ModelUnavailable(ModelKind),
     #[error(transparent)]
     Run(#[from] Box<RunFailure>),
     #[error(transparent)]
@@ -33,44 +31,55 @@ pub enum SimulateError {
     NoMode,
 }
 
-/// A scenario's model, ready for the closed loop (the one place that matches on the model kind).
-pub enum AnyModel {
-    Elastic(Elastic),
-    Lumped(Box<Lumped>),
-    Fe(Box<Fe>),
-}
+/// A cable model, whichever the scenario names: what the closed loop runs.
+pub type DynModel = Box<dyn CableModel + Send>;
 
-impl AnyModel {
-    /// The model the scenario asks for, or why it cannot be had.
-    pub fn new(scenario: &Scenario) -> Result<Self, SimulateError> {
-        match scenario.model.kind {
-            ModelKind::Elastic => Ok(AnyModel::Elastic(Elastic::new(scenario))),
-            ModelKind::Lumped => Ok(AnyModel::Lumped(Box::new(Lumped::new(scenario)?))),
-            ModelKind::Fe => Ok(AnyModel::Fe(Box::new(Fe::new(scenario)?))),
-        }
-    }
+/// The scenario's cable model (the one place that matches on the model kind).
+pub fn model(scenario: &Scenario) -> Result<DynModel, SimulateError> {
+    Ok(match scenario.model.kind {
+        ModelKind::Elastic => Box::new(Elastic::new(scenario)),
+        ModelKind::Lumped => Box::new(Lumped::new(scenario)?),
+        ModelKind::Fe => Box::new(Fe::new(scenario)?),
+    })
 }
 
 /// Simulates the scenario (MODELS.md §2 initial state, DOPRI5 run, samples every sample period).
 pub fn simulate(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Run, SimulateError> {
-    let opts = RunOptions::from(scenario);
-    match AnyModel::new(scenario)? {
-        AnyModel::Elastic(m) => Ok(run_loop(
-            &mut ClosedLoop::new(m, scenario),
-            &opts,
-            progress,
-        )?),
-        AnyModel::Lumped(m) => Ok(run_loop(
-            &mut ClosedLoop::new(*m, scenario),
-            &opts,
-            progress,
-        )?),
-        AnyModel::Fe(m) => Ok(run_loop(
-            &mut ClosedLoop::new(*m, scenario),
-            &opts,
-            progress,
-        )?),
+    let mut sys = ClosedLoop::new(model(scenario)?, scenario);
+    Ok(run_loop(&mut sys, &RunOptions::from(scenario), progress)?)
+}
+
+/// One model's run of a scenario, measured the way MODELS.md §8 judges it.
+pub struct Assessed {
+    pub kind: ModelKind,
+    pub run: Run,
+    pub metrics: Metrics,
+    pub end: EndState,
+}
+
+impl Assessed {
+    /// The view the acceptance table takes.
+    pub fn result(&self) -> acceptance::ModelResult<'_> {
+        acceptance::ModelResult {
+            kind: self.kind,
+            metrics: &self.metrics,
+            vertical_mode: self.end.mode.omega,
+        }
     }
+}
+
+/// Simulates the scenario and measures it: metrics (§7) and the settled end state (mode, equilibrium).
+pub fn assess(
+    scenario: &Scenario,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Assessed, SimulateError> {
+    let run = simulate(scenario, progress)?;
+    Ok(Assessed {
+        kind: scenario.model.kind,
+        metrics: metrics(scenario, &run),
+        end: end_state(scenario)?,
+        run,
+    })
 }
 
 /// Metrics of a run of `scenario` (MODELS.md §7).
@@ -102,11 +111,7 @@ pub struct EndState {
 
 /// [`EndState`] of the scenario's model.
 pub fn end_state(scenario: &Scenario) -> Result<EndState, SimulateError> {
-    match AnyModel::new(scenario)? {
-        AnyModel::Elastic(m) => end_state_of(ClosedLoop::new(m, scenario), scenario),
-        AnyModel::Lumped(m) => end_state_of(ClosedLoop::new(*m, scenario), scenario),
-        AnyModel::Fe(m) => end_state_of(ClosedLoop::new(*m, scenario), scenario),
-    }
+    end_state_of(ClosedLoop::new(model(scenario)?, scenario), scenario)
 }
 
 fn end_state_of<M: CableModel>(

@@ -3,25 +3,14 @@
 
 use cdpr_core::closed_loop::RunError;
 use cdpr_core::scenario::Scenario;
-use cdpr_verify::acceptance::{self, ModelResult};
-use cdpr_verify::{SimulateError, eq15_at_end, metrics, simulate, vertical_mode_at_end};
+use cdpr_verify::acceptance;
+use cdpr_verify::{SimulateError, assess, eq15_at_end, simulate, vertical_mode_at_end};
 
 #[test]
 fn paper_scenario_meets_every_section_8_row() {
     let scenario = Scenario::paper();
-    let run = simulate(&scenario, &mut |_| {}).unwrap();
-    let m = metrics(&scenario, &run);
-    let mode = vertical_mode_at_end(&scenario).unwrap();
-    let result = ModelResult {
-        kind: scenario.model.kind,
-        metrics: &m,
-        vertical_mode: mode.omega,
-    };
-    let mut rows = acceptance::model_checks(&result);
-    rows.extend(acceptance::scenario_checks(
-        eq15_at_end(&scenario),
-        &[result],
-    ));
+    let elastic = assess(&scenario, &mut |_| {}).unwrap();
+    let rows = acceptance::table(eq15_at_end(&scenario), &[elastic.result()]);
     let failed: Vec<_> = rows.iter().filter(|c| !c.pass).collect();
     assert!(failed.is_empty(), "failed §8 rows: {failed:#?}");
     assert!(

@@ -13,27 +13,18 @@ use cdpr_core::metrics::Metrics;
 use cdpr_core::modal::Mode;
 use cdpr_core::scenario::{ModelKind, Scenario};
 use cdpr_core::trajectory::Step5;
+use cdpr_verify::Assessed as Outcome;
 use cdpr_verify::acceptance::{self, Check, ModelResult};
-use cdpr_verify::{EndState, SimulateError};
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
 use std::io::IsTerminal;
 use std::path::Path;
-
-/// One model's paper run and what the report says about it.
-struct Outcome {
-    kind: ModelKind,
-    run: Run,
-    metrics: Metrics,
-    end: EndState,
-}
 
 #[derive(serde::Serialize)]
 struct ReportFile<'a> {
     eq15_rad_s: f64,
     models: Vec<ModelEntry<'a>>,
     checks: &'a [Check],
-    skipped: Vec<&'static str>,
 }
 
 #[derive(serde::Serialize)]
@@ -74,24 +65,12 @@ fn bars(kinds: &[ModelKind]) -> (MultiProgress, Vec<ProgressBar>) {
     (multi, bars)
 }
 
-/// Runs one model of the scenario; `None` if the model does not exist yet.
-fn run_model(scenario: &Scenario, bar: &ProgressBar) -> Result<Option<Outcome>> {
-    let run = match cdpr_verify::simulate(scenario, &mut |f| bar.set_position((f * 1000.0) as u64))
-    {
-        Ok(run) => run,
-        Err(SimulateError::ModelUnavailable(_)) => {
-            bar.finish_and_clear();
-            return Ok(None);
-        }
-        Err(e) => bail!("{} model: {e}", scenario.model.kind),
-    };
+/// Runs and measures one model of the scenario.
+fn run_model(scenario: &Scenario, bar: &ProgressBar) -> Result<Outcome> {
+    let outcome = cdpr_verify::assess(scenario, &mut |f| bar.set_position((f * 1000.0) as u64))
+        .map_err(|e| anyhow::anyhow!("{} model: {e}", scenario.model.kind))?;
     bar.finish();
-    Ok(Some(Outcome {
-        kind: scenario.model.kind,
-        metrics: cdpr_verify::metrics(scenario, &run),
-        end: cdpr_verify::end_state(scenario)?,
-        run,
-    }))
+    Ok(outcome)
 }
 
 pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
@@ -100,7 +79,7 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     let kinds = [ModelKind::Elastic, ModelKind::Lumped, ModelKind::Fe];
     let (_multi, bars) = bars(&kinds);
     // One thread per model: the machine's cores run them side by side; results keep model order.
-    let results: Vec<Result<Option<Outcome>>> = std::thread::scope(|scope| {
+    let results: Vec<Result<Outcome>> = std::thread::scope(|scope| {
         let handles: Vec<_> = kinds
             .iter()
             .zip(&bars)
@@ -118,26 +97,11 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
             })
             .collect()
     });
-    let mut outcomes = Vec::new();
-    let mut skipped = Vec::new();
-    for (kind, result) in kinds.iter().zip(results) {
-        match result? {
-            Some(o) => outcomes.push(o),
-            None => skipped.push(kind.name()),
-        }
-    }
+    let outcomes = results.into_iter().collect::<Result<Vec<Outcome>>>()?;
 
     let eq15 = cdpr_verify::eq15_at_end(&base);
-    let views: Vec<ModelResult> = outcomes
-        .iter()
-        .map(|o| ModelResult {
-            kind: o.kind,
-            metrics: &o.metrics,
-            vertical_mode: o.end.mode.omega,
-        })
-        .collect();
-    let mut checks: Vec<Check> = views.iter().flat_map(acceptance::model_checks).collect();
-    checks.extend(acceptance::scenario_checks(eq15, &views));
+    let views: Vec<ModelResult> = outcomes.iter().map(Outcome::result).collect();
+    let checks = acceptance::table(eq15, &views);
 
     let names = write_figures(&base, &outcomes, eq15, out)?;
     write_json(
@@ -154,10 +118,9 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
                 })
                 .collect(),
             checks: &checks,
-            skipped: skipped.clone(),
         },
     )?;
-    write_markdown(&base, &outcomes, &checks, &skipped, eq15, &names, out)?;
+    write_markdown(&base, &outcomes, &checks, eq15, &names, out)?;
     let failed = checks.iter().filter(|c| !c.pass).count();
     println!(
         "{} models, {} checks, {} failed → {}",
@@ -400,7 +363,6 @@ fn write_markdown(
     base: &Scenario,
     outcomes: &[Outcome],
     checks: &[Check],
-    skipped: &[&str],
     eq15: f64,
     figures: &[(String, String)],
     out: &Path,
@@ -420,9 +382,6 @@ fn write_markdown(
             "**{passed} of {} checks of MODELS.md §8 pass.**",
             checks.len()
         )?;
-        if !skipped.is_empty() {
-            writeln!(w, " Models not implemented yet: {}.", skipped.join(", "))?;
-        }
         writeln!(w)?;
         writeln!(
             w,

@@ -9,6 +9,7 @@
 
 pub mod closed_loop;
 pub mod controller;
+pub mod geometry;
 pub mod integrate;
 pub mod metrics;
 pub mod modal;

@@ -140,3 +140,57 @@ pub trait CableModel {
     /// Values of [`CableModel::channel_names`] for `state` under the tensions `[T1, T2]`.
     fn channels(&self, state: &[f64], tensions: [f64; 2], out: &mut [f64]);
 }
+
+/// A boxed model is a model: one dispatcher can hand any model to the closed loop
+/// (`ClosedLoop<Box<dyn CableModel + Send>>`); the model's own arithmetic stays statically
+/// dispatched, and one virtual call per right-hand side is negligible next to it.
+impl<M: CableModel + ?Sized> CableModel for Box<M> {
+    fn name(&self) -> &'static str {
+        (**self).name()
+    }
+    fn state_len(&self) -> usize {
+        (**self).state_len()
+    }
+    fn equilibrium(
+        &mut self,
+        effector_x: f64,
+        tension_sum: f64,
+    ) -> Result<Equilibrium, ModelError> {
+        (**self).equilibrium(effector_x, tension_sum)
+    }
+    fn rhs(&mut self, t: f64, state: &[f64], tensions: [f64; 2], rate: &mut [f64]) {
+        (**self).rhs(t, state, tensions, rate)
+    }
+    fn effector(&self, state: &[f64]) -> Effector {
+        (**self).effector(state)
+    }
+    fn reel_speeds(&self, state: &[f64]) -> [f64; 2] {
+        (**self).reel_speeds(state)
+    }
+    fn energy(&self, state: &[f64]) -> Energy {
+        (**self).energy(state)
+    }
+    fn dissipation(&self, state: &[f64]) -> f64 {
+        (**self).dissipation(state)
+    }
+    fn event_count(&self) -> usize {
+        (**self).event_count()
+    }
+    fn event_functions(&self, state: &[f64], out: &mut [f64]) {
+        (**self).event_functions(state, out)
+    }
+    fn apply_event(
+        &mut self,
+        index: usize,
+        t: f64,
+        state: &mut [f64],
+    ) -> Result<ModelEvent, ModelError> {
+        (**self).apply_event(index, t, state)
+    }
+    fn channel_names(&self) -> Vec<String> {
+        (**self).channel_names()
+    }
+    fn channels(&self, state: &[f64], tensions: [f64; 2], out: &mut [f64]) {
+        (**self).channels(state, tensions, out)
+    }
+}

@@ -94,7 +94,13 @@ impl Chain {
     pub fn equilibrium(&self) -> Result<Vec<Vector2<f64>>, ModelError> {
         let n = self.elements;
         let mut u = Vec::with_capacity(2 * (n - 1));
-        for p in &self.taut_start()[1..n] {
+        for p in &cdpr_core::geometry::sagging_polygon(
+            self.ends[0],
+            self.ends[1],
+            n,
+            self.segment * (1.0 + 1e-6),
+        )[1..n]
+        {
             u.extend_from_slice(&[p.x, p.y]);
         }
         // Stage 1, the bilateral chain (springs may push): smooth, so Newton is well-posed from
@@ -141,48 +147,6 @@ impl Chain {
             opts,
         )?;
         Ok((0..=n).map(|k| self.node(&u, k)).collect())
-    }
-}
-
-impl Chain {
-    /// N equal chords of length l0·(1 + 1e-6) from A to B: a straight line if they reach, else a
-    /// circular-arc polygon sagging below AB (angle per chord θ by bisection on
-    /// sin(Nθ/2)/sin(θ/2) = |AB|/chord). Every spring starts taut, so no Jacobian column is zero.
-    fn taut_start(&self) -> Vec<Vector2<f64>> {
-        let n = self.elements as f64;
-        let [a, b] = self.ends;
-        let span = (b - a).norm();
-        let side = self.segment * (1.0 + 1e-6);
-        let along = (b - a) / span;
-        if span >= n * side {
-            return (0..=self.elements)
-                .map(|k| a + (b - a) * (k as f64 / n))
-                .collect();
-        }
-        let ratio = span / side;
-        let (mut lo, mut hi) = (0.0, 2.0 * std::f64::consts::PI / n);
-        for _ in 0..200 {
-            let theta = 0.5 * (lo + hi);
-            if (n * theta / 2.0).sin() / (theta / 2.0).sin() > ratio {
-                lo = theta;
-            } else {
-                hi = theta;
-            }
-        }
-        let theta = 0.5 * (lo + hi);
-        let radius = side / (2.0 * (theta / 2.0).sin());
-        // Unit normal pointing down (the sag side).
-        let mut down = Vector2::new(-along.y, along.x);
-        if down.y > 0.0 {
-            down = -down;
-        }
-        let centre = (a + b) * 0.5 - down * (radius * (n * theta / 2.0).cos());
-        (0..=self.elements)
-            .map(|k| {
-                let angle = -n * theta / 2.0 + k as f64 * theta;
-                centre + (along * angle.sin() + down * angle.cos()) * radius
-            })
-            .collect()
     }
 }
 
