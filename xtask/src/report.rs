@@ -326,7 +326,8 @@ fn write_figures(
     Ok(names)
 }
 
-fn git_revision() -> String {
+/// The git revision, marked when tracked files other than the report's own output differ.
+fn git_revision(out: &Path) -> String {
     let run = |args: &[&str]| {
         std::process::Command::new("git")
             .args(args)
@@ -335,17 +336,24 @@ fn git_revision() -> String {
             .filter(|o| o.status.success())
             .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_owned())
     };
-    match run(&["rev-parse", "--short=12", "HEAD"]) {
-        Some(rev) => {
-            let dirty = run(&["status", "--porcelain", "--untracked-files=no"])
-                .is_some_and(|s| !s.is_empty());
-            if dirty {
-                format!("{rev} (with uncommitted changes)")
-            } else {
-                rev
-            }
-        }
-        None => "unknown (not a git checkout)".into(),
+    let Some(rev) = run(&["rev-parse", "--short=12", "HEAD"]) else {
+        return "unknown (not a git checkout)".into();
+    };
+    let out = out
+        .to_string_lossy()
+        .trim_start_matches("./")
+        .trim_end_matches('/')
+        .to_owned();
+    let dirty = run(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| {
+        s.lines().any(|l| {
+            let path = l.get(3..).unwrap_or("");
+            out.is_empty() || !path.starts_with(&format!("{out}/"))
+        })
+    });
+    if dirty {
+        format!("{rev} (with uncommitted changes)")
+    } else {
+        rev
     }
 }
 
@@ -484,7 +492,7 @@ fn write_markdown(
             w,
             "- cdpr-bench {} at git revision {}",
             env!("CARGO_PKG_VERSION"),
-            git_revision()
+            git_revision(out)
         )?;
         writeln!(w, "- {}", rustc_version())?;
         writeln!(
