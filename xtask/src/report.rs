@@ -334,7 +334,7 @@ fn git_revision(out: &Path) -> String {
             .output()
             .ok()
             .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_owned())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim_end().to_owned())
     };
     let Some(rev) = run(&["rev-parse", "--short=12", "HEAD"]) else {
         return "unknown (not a git checkout)".into();
