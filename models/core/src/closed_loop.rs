@@ -117,8 +117,7 @@ impl<M: CableModel> OdeSystem for ClosedLoop<M> {
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
         let n = self.model_len();
         let cmd = self.command(t, y);
-        let (_, pid_state) = self.split(y);
-        let (model_state, tail) = y.split_at(n);
+        let (model_state, pid_state) = self.split(y);
         let (model_rate, tail_rate) = dy.split_at_mut(n);
         self.model.rhs(t, model_state, cmd.tensions, model_rate);
         let pid_rate = self.pid.state_rate(cmd.error, pid_state);
@@ -127,7 +126,6 @@ impl<M: CableModel> OdeSystem for ClosedLoop<M> {
         tail_rate[1] = pid_rate.filter;
         tail_rate[2] = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
         tail_rate[3] = self.model.dissipation(model_state);
-        let _ = tail;
     }
 }
 
