@@ -25,6 +25,34 @@ pub enum ModelError {
     State { t: f64, why: String },
 }
 
+/// The channels every massive-cable model provides, named alike so that the report and the
+/// cross-model tests compare them: tension at the effector end and next to the pulley [N], free
+/// unstrained length [m], and the stored amount (lumped: nodes; FE: length ρ_i [m]), per cable.
+pub const CABLE_CHANNELS: [&str; 8] = [
+    "T_effector_1",
+    "T_effector_2",
+    "T_pulley_1",
+    "T_pulley_2",
+    "l_free_1",
+    "l_free_2",
+    "stored_1",
+    "stored_2",
+];
+
+/// MODELS.md §2 holds the effector's x fixed for the static equilibrium: it must lie strictly
+/// between the pulleys A1 = (0, 0) and A2 = (d, 0).
+pub fn check_effector_x(effector_x: f64, anchor_distance: f64) -> Result<(), ModelError> {
+    if effector_x > 0.0 && effector_x < anchor_distance {
+        Ok(())
+    } else {
+        Err(ModelError::Parameter {
+            name: "effector x",
+            value: effector_x,
+            allowed: format!("(0, {anchor_distance}) m between the pulleys"),
+        })
+    }
+}
+
 /// Position and velocity of the effector (the point mass C of the paper) [m, m/s].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Effector {

@@ -143,14 +143,8 @@ impl CableModel for Elastic {
         effector_x: f64,
         tension_sum: f64,
     ) -> Result<Equilibrium, ModelError> {
+        cdpr_core::model::check_effector_x(effector_x, self.anchor_distance)?;
         let d = self.anchor_distance;
-        if !(effector_x > 0.0 && effector_x < d) {
-            return Err(ModelError::Parameter {
-                name: "effector x",
-                value: effector_x,
-                allowed: format!("(0, {d}) m between the pulleys"),
-            });
-        }
         if self.effector_mass * self.gravity >= tension_sum {
             return Err(ModelError::Parameter {
                 name: "tension_sum",

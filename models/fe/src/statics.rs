@@ -77,14 +77,8 @@ pub(crate) fn equilibrium(
     effector_x: f64,
     tension_sum: f64,
 ) -> Result<Equilibrium, ModelError> {
+    cdpr_core::model::check_effector_x(effector_x, model.anchor_distance)?;
     let d = model.anchor_distance;
-    if !(effector_x > 0.0 && effector_x < d) {
-        return Err(ModelError::Parameter {
-            name: "effector x",
-            value: effector_x,
-            allowed: format!("(0, {d}) m between the pulleys"),
-        });
-    }
     let n = model.elements;
     let np = model.positions_len();
     let mat = model.material;

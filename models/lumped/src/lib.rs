@@ -408,18 +408,7 @@ impl CableModel for Lumped {
     }
 
     fn channel_names(&self) -> Vec<String> {
-        [
-            "T_effector_1",
-            "T_effector_2",
-            "T_pulley_1",
-            "T_pulley_2",
-            "l_free_1",
-            "l_free_2",
-            "stored_1",
-            "stored_2",
-        ]
-        .map(String::from)
-        .to_vec()
+        cdpr_core::model::CABLE_CHANNELS.map(String::from).to_vec()
     }
 
     /// Spring tensions at the effector and over the pulley [N], free unstrained lengths [m] and

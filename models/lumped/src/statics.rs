@@ -165,14 +165,8 @@ pub(crate) fn equilibrium(
     effector_x: f64,
     tension_sum: f64,
 ) -> Result<Equilibrium, ModelError> {
+    cdpr_core::model::check_effector_x(effector_x, model.anchor_distance)?;
     let d = model.anchor_distance;
-    if !(effector_x > 0.0 && effector_x < d) {
-        return Err(ModelError::Parameter {
-            name: "effector x",
-            value: effector_x,
-            allowed: format!("(0, {d}) m between the pulleys"),
-        });
-    }
     // Massless-cable sag as the effector's starting depth; the cable weight adds ~1 %.
     let weight = model.effector_mass * model.gravity;
     let sag = -weight * effector_x * (d - effector_x) / (0.5 * tension_sum * d);
