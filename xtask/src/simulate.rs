@@ -37,10 +37,10 @@ pub fn run(scenario: Option<&Path>, model: Option<&str>, out: &Path, every: usiz
     let scenario = load_scenario(scenario, model)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let bar = progress_bar(scenario.model.kind.name());
-    let result = cdpr_verify::simulate(&scenario, &mut |f| bar.set_position((f * 1000.0) as u64));
+    let result = cdpr_verify::assess(&scenario, &mut |f| bar.set_position((f * 1000.0) as u64));
     bar.finish_and_clear();
-    let run = match result {
-        Ok(run) => run,
+    let assessed = match result {
+        Ok(assessed) => assessed,
         Err(SimulateError::Run(failure)) => {
             if let Some(partial) = &failure.partial {
                 write_csv(&out.join("timeseries.csv"), &partial.series, every)?;
@@ -52,13 +52,12 @@ pub fn run(scenario: Option<&Path>, model: Option<&str>, out: &Path, every: usiz
         }
         Err(e) => return Err(e.into()),
     };
-    let metrics = cdpr_verify::metrics(&scenario, &run);
-    let mode = cdpr_verify::vertical_mode_at_end(&scenario)?;
+    let (run, metrics, mode) = (&assessed.run, &assessed.metrics, assessed.end.mode);
     write_csv(&out.join("timeseries.csv"), &run.series, every)?;
     write_json(
         &out.join("metrics.json"),
         &MetricsFile {
-            metrics: &metrics,
+            metrics,
             vertical_mode_rad_s: mode.omega,
             vertical_mode_growth: mode.growth,
             eq15_rad_s: cdpr_verify::eq15_at_end(&scenario),

@@ -9,14 +9,9 @@ pub struct TimeSeries {
 }
 
 impl TimeSeries {
-    /// An empty series with room for `rows` samples.
-    pub fn with_capacity(names: Vec<String>, rows: usize) -> Self {
-        Self::with_buffer(names, rows, Vec::new())
-    }
-
-    /// As [`TimeSeries::with_capacity`], reusing `buffer`'s memory (e.g. from
-    /// [`TimeSeries::into_buffer`] of a previous run): a sweep then allocates and faults in its
-    /// output memory once, not once per run.
+    /// An empty series with room for `rows` samples, in `buffer`'s memory (e.g. from
+    /// [`TimeSeries::into_buffer`] of a previous run; `Vec::new()` for fresh memory): a sweep then
+    /// allocates and faults in its output memory once, not once per run.
     pub fn with_buffer(names: Vec<String>, rows: usize, mut buffer: Vec<f64>) -> Self {
         buffer.clear();
         buffer.reserve(rows * names.len());

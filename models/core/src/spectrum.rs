@@ -146,21 +146,7 @@ impl Spectrum {
     /// The largest local maximum with ω > `min_omega` (refined), e.g. the discretisation modes
     /// above the physics of interest.
     pub fn largest_local_max_above(&self, min_omega: f64) -> Option<Peak> {
-        let k0 = ((min_omega / self.omega_step).floor() as usize + 1).max(1);
-        let a = &self.amplitude;
-        let mut best: Option<usize> = None;
-        for k in k0..a.len().saturating_sub(1) {
-            if a[k] > a[k - 1] && a[k] >= a[k + 1] && best.is_none_or(|b| a[k] > a[b]) {
-                best = Some(k);
-            }
-        }
-        best.map(|bin| {
-            self.refine(Peak {
-                omega: self.omega(bin),
-                amplitude: a[bin],
-                bin,
-            })
-        })
+        self.local_maxima_above(min_omega, 1).into_iter().next()
     }
 }
 
