@@ -7,7 +7,10 @@
 //! (ΔE the energy changes of model events) a channel of every run.
 
 use crate::controller::{Pid, PidState, TensionDistribution};
-use crate::integrate::{Dopri5, Dopri5Options, IntegratorError, OdeSystem, SolverStats};
+use crate::integrate::{
+    Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions, IntegratorError, OdeSystem,
+    SecondOrderSystem, SolverStats, Stepper,
+};
 use crate::model::{CableModel, Equilibrium, ModelError, ModelEvent};
 use crate::scenario::{IntegratorKind, Scenario};
 use crate::series::TimeSeries;
@@ -43,6 +46,22 @@ pub struct ClosedLoop<M: CableModel> {
     pub pid: Pid,
     pub distribution: TensionDistribution,
     pub actuation: Actuation,
+    /// The start of the current implicit step (the trapezoidal controller and audit updates).
+    step_start: StepStart,
+}
+
+/// What an implicit step needs from its start (t_n, y_n) besides the integrator's own state.
+#[derive(Debug, Clone, Copy, Default)]
+struct StepStart {
+    h: f64,
+    error: f64,
+    pid: PidState,
+    /// Reel power Σ T_i v_reel,i [W] and model dissipation [W] at t_n.
+    power: f64,
+    dissipation: f64,
+    /// W and D at t_n [J].
+    work: f64,
+    dissipated: f64,
 }
 
 /// Number of controller and audit states after the model's.
@@ -57,6 +76,7 @@ impl<M: CableModel> ClosedLoop<M> {
             pid: Pid::from(&scenario.controller),
             distribution: TensionDistribution::from(&scenario.controller),
             actuation: Actuation::Pid,
+            step_start: StepStart::default(),
         }
     }
 
@@ -129,6 +149,131 @@ impl<M: CableModel> OdeSystem for ClosedLoop<M> {
     }
 }
 
+/// The implicit path (MODELS.md FE.9.3): the model's second-order form with the PID states updated
+/// by the trapezoidal rule inside the same residual, so the tensions at t_{n+1} follow the effector
+/// position of the iterate, and the audit states W, D by the trapezoidal rule after convergence.
+/// Only for models that offer [`CableModel::second_order`] (the runner checks first).
+impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
+    fn dofs(&self) -> usize {
+        self.model.second_order().map_or(0, |f| f.dofs())
+    }
+
+    fn iteration_pattern(&self) -> Vec<(usize, usize)> {
+        let Some(form) = self.model.second_order() else {
+            return Vec::new();
+        };
+        let mut pattern = form.iteration_pattern();
+        let x = form.effector_x();
+        pattern.extend(form.tension_rows().into_iter().map(|row| (row, x)));
+        pattern
+    }
+
+    fn begin_step(&mut self, t: f64, y: &[f64], h: f64) {
+        let n = self.model_len();
+        let cmd = self.command(t, y);
+        let (model_state, pid) = self.split(y);
+        let reel = self.model.reel_speeds(model_state);
+        self.step_start = StepStart {
+            h,
+            error: cmd.error,
+            pid,
+            power: cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1],
+            dissipation: self.model.dissipation(model_state),
+            work: y[n + 2],
+            dissipated: y[n + 3],
+        };
+    }
+
+    fn residual(&mut self, t: f64, y: &[f64], qdd: &[f64], r: &mut [f64]) {
+        let n = self.model_len();
+        let tensions = self.step_end_command(t, &y[..n]).tensions;
+        if let Some(form) = self.model.second_order_mut() {
+            form.residual(&y[..n], qdd, tensions, r);
+        }
+    }
+
+    fn iteration_matrix(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        qdd: &[f64],
+        c_v: f64,
+        c_q: f64,
+        values: &mut [f64],
+    ) -> u64 {
+        let n = self.model_len();
+        let tensions = self.step_end_command(t, &y[..n]).tensions;
+        // dT/dx of the effector through the trapezoidal PID: T is affine in x (unless saturated),
+        // so a unit difference is exact.
+        let Some(x_index) = self.model.second_order().map(|f| f.effector_x()) else {
+            return 0;
+        };
+        let mut shifted = y[..n].to_vec();
+        shifted[x_index] += 1.0;
+        let moved = self.step_end_command(t, &shifted).tensions;
+        let slope = [moved[0] - tensions[0], moved[1] - tensions[1]];
+        let Some(form) = self.model.second_order_mut() else {
+            return 0;
+        };
+        let model_entries = form.iteration_pattern().len();
+        let mut evals = form.iteration_matrix(&y[..n], qdd, tensions, c_v, c_q, values);
+        let rows = form.tension_rows();
+        if slope != [0.0, 0.0] && !rows.is_empty() {
+            // Column x of ∂R/∂T · dT/dx, by one more residual (R is linear in T).
+            let dofs = form.dofs();
+            let mut base = vec![0.0; dofs];
+            let mut probe = vec![0.0; dofs];
+            form.residual(&y[..n], qdd, tensions, &mut base);
+            let pulled = [tensions[0] + slope[0], tensions[1] + slope[1]];
+            form.residual(&y[..n], qdd, pulled, &mut probe);
+            evals += 2;
+            for (k, &row) in rows.iter().enumerate() {
+                values[model_entries + k] = c_q * (probe[row] - base[row]);
+            }
+        } else {
+            values[model_entries..].fill(0.0);
+        }
+        evals
+    }
+
+    fn end_step(&mut self, t: f64, y: &mut [f64]) {
+        let n = self.model_len();
+        let s = self.step_start;
+        let error = self.trajectory.position(t) - self.model.effector(&y[..n]).position.x;
+        let pid = self.pid.trapezoidal_step(s.pid, s.error, error, s.h);
+        y[n] = pid.integral;
+        y[n + 1] = pid.filter;
+        let cmd = self.command(t, y);
+        let reel = self.model.reel_speeds(&y[..n]);
+        let power = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
+        let dissipation = self.model.dissipation(&y[..n]);
+        y[n + 2] = s.work + 0.5 * s.h * (s.power + power);
+        y[n + 3] = s.dissipated + 0.5 * s.h * (s.dissipation + dissipation);
+    }
+}
+
+impl<M: CableModel> ClosedLoop<M> {
+    /// The command at the end t of the current implicit step for the model state `model_state`:
+    /// the PID states advanced by the trapezoidal rule from the step's start.
+    fn step_end_command(&self, t: f64, model_state: &[f64]) -> Command {
+        let s = self.step_start;
+        let reference = self.trajectory.position(t);
+        let error = reference - self.model.effector(model_state).position.x;
+        let pid = self.pid.trapezoidal_step(s.pid, s.error, error, s.h);
+        let force = self.pid.force(error, pid);
+        let tensions = match &self.actuation {
+            Actuation::Pid => self.distribution.tensions(force),
+            Actuation::Prescribed(f) => f(t),
+        };
+        Command {
+            reference,
+            error,
+            force,
+            tensions,
+        }
+    }
+}
+
 /// Why a run stopped early.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RunError {
@@ -143,8 +288,15 @@ pub enum RunError {
     /// A commanded tension ≤ 0 (MODELS.md §2): a cable cannot push.
     #[error("cable {cable} went slack at t = {t} s: commanded tension {tension} N ≤ 0")]
     SlackCable { t: f64, cable: usize, tension: f64 },
-    #[error("integrator `{0}` is not available yet (only dopri5)")]
-    Unsupported(&'static str),
+    /// The scenario asks for an integrator the model does not support.
+    #[error(
+        "simulation.integrator = \"{integrator}\" is not available for the {model} model: {why}"
+    )]
+    Unsupported {
+        integrator: &'static str,
+        model: &'static str,
+        why: &'static str,
+    },
 }
 
 /// Output of a run: sampled channels, counters, the initial equilibrium, the state at the end.
@@ -214,6 +366,7 @@ pub struct RunOptions {
     pub sample_period: f64,
     pub integrator: IntegratorKind,
     pub dopri: Dopri5Options,
+    pub implicit: GeneralizedAlphaOptions,
 }
 
 impl From<&Scenario> for RunOptions {
@@ -228,6 +381,11 @@ impl From<&Scenario> for RunOptions {
                 atol: sim.atol,
                 beta: sim.dopri_beta,
                 ..Dopri5Options::default()
+            },
+            implicit: GeneralizedAlphaOptions {
+                step: sim.step,
+                rho_inf: sim.rho_inf,
+                ..GeneralizedAlphaOptions::default()
             },
         }
     }
@@ -309,39 +467,55 @@ fn integrate_and_sample<M: CableModel>(
         samples,
         period: opts.sample_period,
     };
-    let mut dopri = Dopri5::new(
-        y0.len(),
-        Dopri5Options {
-            norm_components: Some(n + 2),
-            ..opts.dopri
-        },
-    );
     let mut events = Vec::new();
-    let outcome = if opts.integrator == IntegratorKind::Dopri5 {
-        integrate(
-            sys,
-            &y0,
-            opts.t_final,
-            &mut dopri,
-            &mut sampler,
-            &mut events,
-            progress,
-        )
-    } else {
-        Err(RunError::Unsupported("implicit"))
+    let mut dopri;
+    let mut alpha;
+    let stepper: &mut dyn Stepper<ClosedLoop<M>> = match opts.integrator {
+        IntegratorKind::Dopri5 => {
+            dopri = Dopri5::new(
+                y0.len(),
+                Dopri5Options {
+                    norm_components: Some(n + 2),
+                    ..opts.dopri
+                },
+            );
+            &mut dopri
+        }
+        IntegratorKind::Implicit => {
+            alpha = GeneralizedAlpha::new(opts.implicit);
+            &mut alpha
+        }
     };
-    let t_reached = if dopri.stats().rhs_evals == 0 {
+    let outcome =
+        if opts.integrator == IntegratorKind::Implicit && sys.model.second_order().is_none() {
+            Err(RunError::Unsupported {
+                integrator: "implicit",
+                model: sys.model.name(),
+                why: "the model offers no second-order form",
+            })
+        } else {
+            integrate(
+                sys,
+                &y0,
+                opts.t_final,
+                stepper,
+                &mut sampler,
+                &mut events,
+                progress,
+            )
+        };
+    let t_reached = if stepper.stats().rhs_evals == 0 {
         0.0
     } else {
-        dopri.time()
+        stepper.time()
     };
     let run = Run {
         model: sys.model.name(),
         series: sampler.series,
-        stats: dopri.stats(),
+        stats: stepper.stats(),
         equilibrium,
         final_state: if t_reached > 0.0 {
-            dopri.state().to_vec()
+            stepper.state().to_vec()
         } else {
             y0
         },
@@ -363,35 +537,39 @@ fn integrate<M: CableModel>(
     sys: &mut ClosedLoop<M>,
     y0: &[f64],
     t_end: f64,
-    dopri: &mut Dopri5,
+    stepper: &mut dyn Stepper<ClosedLoop<M>>,
     sampler: &mut Sampler,
     events: &mut Vec<ModelEvent>,
     progress: &mut dyn FnMut(f64),
 ) -> Result<(), RunError> {
     let integrator = |t: f64| move |source| RunError::Integrator { t, source };
-    dopri.start(sys, 0.0, y0, t_end).map_err(integrator(0.0))?;
+    stepper
+        .start(sys, 0.0, y0, t_end)
+        .map_err(integrator(0.0))?;
     let mut monitor = EventMonitor::new(sys, y0);
-    sampler.sample_through(sys, dopri, 0.0)?;
-    while dopri.time() < t_end {
-        dopri.step(sys, t_end).map_err(integrator(dopri.time()))?;
-        let Some((index, t_event)) = monitor.earliest_crossing(sys, dopri) else {
-            let t = dopri.time();
-            sampler.sample_through(sys, dopri, t)?;
-            check_slack(t, sys.command(t, dopri.state()).tensions)?;
-            monitor.accept(sys, dopri.state());
+    sampler.sample_through(sys, stepper, 0.0)?;
+    while stepper.time() < t_end {
+        stepper
+            .step(sys, t_end)
+            .map_err(integrator(stepper.time()))?;
+        let Some((index, t_event)) = monitor.earliest_crossing(sys, stepper) else {
+            let t = stepper.time();
+            sampler.sample_through(sys, stepper, t)?;
+            check_slack(t, sys.command(t, stepper.state()).tensions)?;
+            monitor.accept(sys, stepper.state());
             progress(t / t_end);
             continue;
         };
         // Samples up to the event come from the step as integrated; the event changes the state
         // there and the integrator restarts from it, abandoning the rest of the step.
-        sampler.sample_through(sys, dopri, t_event)?;
+        sampler.sample_through(sys, stepper, t_event)?;
         let mut y = vec![0.0; y0.len()];
-        dopri.dense_output(t_event, &mut y);
+        stepper.dense_output(t_event, &mut y);
         let n = sys.model_len();
         let event = sys.model.apply_event(index, t_event, &mut y[..n])?;
         sampler.event_energy += event.energy_change;
         events.push(event);
-        dopri.restart(sys, t_event, &y);
+        stepper.restart(sys, t_event, &y);
         check_slack(t_event, sys.command(t_event, &y).tensions)?;
         monitor.accept(sys, &y);
     }
@@ -437,26 +615,26 @@ impl EventMonitor {
     fn earliest_crossing<M: CableModel>(
         &mut self,
         sys: &ClosedLoop<M>,
-        dopri: &Dopri5,
+        stepper: &dyn Stepper<ClosedLoop<M>>,
     ) -> Option<(usize, f64)> {
         if self.before.is_empty() {
             return None;
         }
         let n = sys.model_len();
         sys.model
-            .event_functions(&dopri.state()[..n], &mut self.after);
+            .event_functions(&stepper.state()[..n], &mut self.after);
         let mut earliest: Option<(usize, f64)> = None;
         for k in 0..self.before.len() {
             if !(self.before[k] > 0.0 && self.after[k] <= 0.0) {
                 continue;
             }
-            let (mut a, mut b) = (dopri.previous_time(), dopri.time());
+            let (mut a, mut b) = (stepper.previous_time(), stepper.time());
             while b - a > EVENT_TIME_TOL {
                 let mid = 0.5 * (a + b);
                 if mid <= a || mid >= b {
                     break;
                 }
-                dopri.dense_output(mid, &mut self.y);
+                stepper.dense_output(mid, &mut self.y);
                 sys.model.event_functions(&self.y[..n], &mut self.probe);
                 if self.probe[k] > 0.0 {
                     a = mid;
@@ -506,7 +684,7 @@ impl Sampler {
     fn sample_through<M: CableModel>(
         &mut self,
         sys: &ClosedLoop<M>,
-        dopri: &Dopri5,
+        stepper: &dyn Stepper<ClosedLoop<M>>,
         t: f64,
     ) -> Result<(), RunError> {
         let n = sys.model_len();
@@ -521,10 +699,10 @@ impl Sampler {
             if tk > t {
                 break;
             }
-            if tk == dopri.time() {
-                self.y.copy_from_slice(dopri.state());
+            if tk == stepper.time() {
+                self.y.copy_from_slice(stepper.state());
             } else {
-                dopri.dense_output(tk, &mut self.y);
+                stepper.dense_output(tk, &mut self.y);
             }
             let y = &self.y;
             let cmd = sys.command(tk, y);

@@ -53,6 +53,20 @@ impl Pid {
         }
     }
 
+    /// The states at the end of a step of size h [s] by the trapezoidal rule (MODELS.md FE.9.3),
+    /// from the states and error e_n at its start and the error e_{n+1} at its end:
+    /// w_{n+1} = w_n + h (e_n + e_{n+1})/2,
+    /// f_{n+1} = [f_n (1 − h N_f/2) + h N_f (e_n + e_{n+1})/2] / (1 + h N_f/2).
+    /// A-stable for the filter pole −N_f at any step, second order like the generalised-α step.
+    pub fn trapezoidal_step(&self, start: PidState, e_start: f64, e_end: f64, h: f64) -> PidState {
+        let mean = 0.5 * (e_start + e_end);
+        let k = 0.5 * h * self.filter;
+        PidState {
+            integral: start.integral + h * mean,
+            filter: (start.filter * (1.0 - k) + 2.0 * k * mean) / (1.0 + k),
+        }
+    }
+
     /// State that makes the controller output `force` at zero error and rest: w = F0/I, f = e = 0.
     /// Without integral action (I = 0) no state can hold a force at zero error: `None`.
     pub fn state_holding(&self, force: f64) -> Option<PidState> {

@@ -15,6 +15,7 @@ pub mod metrics;
 pub mod modal;
 pub mod model;
 pub mod scenario;
+pub mod second_order;
 pub mod series;
 pub mod spectrum;
 pub mod statics;

@@ -5,6 +5,7 @@
 //! extra output channels it has. It knows nothing of the controller, the trajectory or the
 //! integrator; the closed loop ([`crate::closed_loop`]) knows nothing of cables.
 
+use crate::second_order::SecondOrderForm;
 use nalgebra::Vector2;
 
 /// Why a model refused a state or could not find its equilibrium.
@@ -167,6 +168,17 @@ pub trait CableModel {
 
     /// Values of [`CableModel::channel_names`] for `state` under the tensions `[T1, T2]`.
     fn channels(&self, state: &[f64], tensions: [f64; 2], out: &mut [f64]);
+
+    /// The model's second-order form for the implicit integrator, if it offers one (its state is
+    /// then `[q | q']`).
+    fn second_order(&self) -> Option<&dyn SecondOrderForm> {
+        None
+    }
+
+    /// Mutable access to [`CableModel::second_order`] (its residual reuses the model's buffers).
+    fn second_order_mut(&mut self) -> Option<&mut dyn SecondOrderForm> {
+        None
+    }
 }
 
 /// A boxed model is a model: one dispatcher can hand any model to the closed loop
@@ -220,5 +232,11 @@ impl<M: CableModel + ?Sized> CableModel for Box<M> {
     }
     fn channels(&self, state: &[f64], tensions: [f64; 2], out: &mut [f64]) {
         (**self).channels(state, tensions, out)
+    }
+    fn second_order(&self) -> Option<&dyn SecondOrderForm> {
+        (**self).second_order()
+    }
+    fn second_order_mut(&mut self) -> Option<&mut dyn SecondOrderForm> {
+        (**self).second_order_mut()
     }
 }

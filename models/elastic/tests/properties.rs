@@ -99,7 +99,8 @@ proptest! {
             sample_period: 1e-3,
             integrator: IntegratorKind::Dopri5,
             dopri: Dopri5Options { rtol: 1e-10, atol: 1e-12, ..Dopri5Options::default() },
-        };
+ implicit: Default::default(),
+};
         let run = simulate_from(&mut sys, y0, eq, &opts, &mut |_| {}).unwrap();
         let s = &run.series;
         let col = |n: &str| s.column(n).unwrap();

@@ -51,6 +51,7 @@ fn equilibrium_is_preserved() {
         sample_period: 1e-3,
         integrator: IntegratorKind::Dopri5,
         dopri: Dopri5Options::default(),
+        implicit: Default::default(),
     };
     let run = simulate_from(&mut sys, y0, eq, &opts, &mut |_| {}).unwrap();
     let x = run.series.column("x").unwrap();
@@ -154,6 +155,7 @@ fn energy_identity_with_prescribed_tensions() {
                 beta: 0.0,
                 ..Dopri5Options::default()
             },
+            implicit: Default::default(),
         };
         let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
         let residual = run.series.column("e_residual").unwrap();

@@ -14,6 +14,7 @@
 //! mode.
 
 pub mod chain;
+mod implicit;
 mod pulley;
 mod statics;
 
@@ -46,6 +47,8 @@ pub struct Lumped {
     stored: [usize; 2],
     /// Per cable, the forces each spring puts on its two end nodes (allocated once).
     scratch: [SpringForces; 2],
+    /// Buffers of the second-order form ([`implicit`]).
+    implicit: implicit::ImplicitScratch,
 }
 
 /// Forces of the springs j = 0 … N−1 of one cable on their end nodes a = P_j and b = P_{j+1} [N].
@@ -109,6 +112,7 @@ impl Lumped {
             damping: cable.axial_damping / segment,
             stored: [n / 2, n / 2],
             scratch: [SpringForces::new(n), SpringForces::new(n)],
+            implicit: Default::default(),
         })
     }
 
@@ -409,6 +413,14 @@ impl CableModel for Lumped {
 
     fn channel_names(&self) -> Vec<String> {
         cdpr_core::model::CABLE_CHANNELS.map(String::from).to_vec()
+    }
+
+    fn second_order(&self) -> Option<&dyn cdpr_core::second_order::SecondOrderForm> {
+        Some(self)
+    }
+
+    fn second_order_mut(&mut self) -> Option<&mut dyn cdpr_core::second_order::SecondOrderForm> {
+        Some(self)
     }
 
     /// Spring tensions at the effector and over the pulley [N], free unstrained lengths [m] and

@@ -194,7 +194,8 @@ proptest! {
             sample_period: 1e-3,
             integrator: IntegratorKind::Dopri5,
             dopri: Dopri5Options { rtol: 1e-9, atol: 1e-12, ..Dopri5Options::default() },
-        };
+ implicit: Default::default(),
+};
         let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
         prop_assert!(run.events.len() >= 4, "the drift moved nodes over the pulleys ({} events)", run.events.len());
         let residual = run.series.column("e_residual").unwrap();

@@ -451,3 +451,36 @@ impl Dopri5 {
         }
     }
 }
+
+impl<S: OdeSystem> super::Stepper<S> for Dopri5 {
+    fn start(
+        &mut self,
+        sys: &mut S,
+        t0: f64,
+        y0: &[f64],
+        t_end: f64,
+    ) -> Result<(), IntegratorError> {
+        Dopri5::start(self, sys, t0, y0, t_end)
+    }
+    fn step(&mut self, sys: &mut S, t_end: f64) -> Result<(), IntegratorError> {
+        Dopri5::step(self, sys, t_end)
+    }
+    fn restart(&mut self, sys: &mut S, t: f64, y: &[f64]) {
+        Dopri5::restart(self, sys, t, y)
+    }
+    fn time(&self) -> f64 {
+        Dopri5::time(self)
+    }
+    fn previous_time(&self) -> f64 {
+        Dopri5::previous_time(self)
+    }
+    fn state(&self) -> &[f64] {
+        Dopri5::state(self)
+    }
+    fn dense_output(&self, t: f64, out: &mut [f64]) {
+        Dopri5::dense_output(self, t, out)
+    }
+    fn stats(&self) -> SolverStats {
+        Dopri5::stats(self)
+    }
+}

@@ -1,9 +1,15 @@
 //! Time integration, independent of any cable: an [`OdeSystem`] says what y' is; integrators know
-//! nothing else about it. [`Dopri5`] is the paper-faithful explicit reference (ode45 class).
+//! nothing else about it. [`Dopri5`] is the paper-faithful explicit reference (ode45 class);
+//! [`GeneralizedAlpha`] the implicit path for stiff second-order systems ([`SecondOrderSystem`]).
+//! Both are driven one accepted step at a time through [`Stepper`], so the runner's sampling and
+//! event location do not depend on the method.
 
 mod dopri5;
+mod generalized_alpha;
+pub mod sparse;
 
 pub use dopri5::{Dopri5, Dopri5Options};
+pub use generalized_alpha::{GeneralizedAlpha, GeneralizedAlphaOptions, SecondOrderSystem};
 
 /// A first-order system y' = f(t, y) of fixed dimension.
 pub trait OdeSystem {
@@ -27,6 +33,41 @@ pub struct SolverStats {
     pub steps_rejected: u64,
     /// Restarts after a discontinuity in the state (model events).
     pub restarts: u64,
+    /// Newton iterations (implicit methods; each costs one residual evaluation, counted in
+    /// `rhs_evals`).
+    pub newton_iterations: u64,
+    /// Iteration-matrix (Jacobian) evaluations (implicit methods; their finite-difference residual
+    /// evaluations are counted in `rhs_evals` too).
+    pub jacobian_evals: u64,
+    /// Numeric LU factorisations of the iteration matrix (implicit methods).
+    pub factorisations: u64,
+}
+
+/// One-step-at-a-time driving of an integrator on system `S`: what the runner needs for sampling
+/// the dense output, locating events and restarting after them.
+pub trait Stepper<S: ?Sized> {
+    /// Initialises at (t0, y0) for an integration towards `t_end`.
+    fn start(
+        &mut self,
+        sys: &mut S,
+        t0: f64,
+        y0: &[f64],
+        t_end: f64,
+    ) -> Result<(), IntegratorError>;
+    /// Takes one accepted step, never past `t_end`.
+    fn step(&mut self, sys: &mut S, t_end: f64) -> Result<(), IntegratorError>;
+    /// Continues from a changed state (t, y), keeping the current step size.
+    fn restart(&mut self, sys: &mut S, t: f64, y: &[f64]);
+    /// Time of the last accepted step [s].
+    fn time(&self) -> f64;
+    /// Start of the last accepted step [s].
+    fn previous_time(&self) -> f64;
+    /// State at [`Self::time`].
+    fn state(&self) -> &[f64];
+    /// The dense output at t within the last accepted step into `out`.
+    fn dense_output(&self, t: f64, out: &mut [f64]);
+    /// Counters so far.
+    fn stats(&self) -> SolverStats;
 }
 
 /// Why an integration stopped.
@@ -43,4 +84,7 @@ pub enum IntegratorError {
     /// Asked to step past the end of the interval or with an inconsistent setup.
     #[error("integrator misuse: {0}")]
     Usage(&'static str),
+    /// The Newton iteration matrix could not be analysed or factorised.
+    #[error("iteration matrix: {0}")]
+    Sparse(#[from] sparse::SparseError),
 }

@@ -1,0 +1,476 @@
+//! Generalised-α for M(q) q'' = F(t, q, q') in the Arnold–Brüls form (MODELS.md FE.9.3; M. Arnold,
+//! O. Brüls, Multibody Syst. Dyn. 18 (2007)): the unknown of each step is the true acceleration
+//! q''_{n+1}, the algorithmic acceleration a carries the method's memory:
+//!
+//! ```text
+//! α_m = (2ρ∞ − 1)/(ρ∞ + 1), α_f = ρ∞/(ρ∞ + 1), γ = ½ + α_f − α_m, β = (γ + ½)²/4
+//! (1 − α_m) a_{n+1} + α_m a_n = (1 − α_f) q''_{n+1} + α_f q''_n
+//! q_{n+1}  = q_n + h q'_n + h² (½ − β) a_n + h² β a_{n+1}
+//! q'_{n+1} = q'_n + h (1 − γ) a_n + h γ a_{n+1}
+//! R(t_{n+1}, q_{n+1}, q'_{n+1}, q''_{n+1}) = M q'' − F = 0,          a_0 = q''_0.
+//! ```
+//!
+//! Second order for every ρ∞ ∈ [0, 1]; ρ∞ is the spectral radius at h·ω → ∞, so ρ∞ < 1 damps the
+//! modes the step does not resolve (the cables' axial modes), ρ∞ = 1 keeps them undamped but
+//! period-distorted. The Newton iteration matrix S = ∂R/∂q'' + γ' ∂R/∂q' + β' ∂R/∂q with
+//! γ' = γh(1 − α_f)/(1 − α_m), β' = βh²(1 − α_f)/(1 − α_m) is a faer sparse LU ([`IterationMatrix`]):
+//! analysed once per run, refactorised only when the modified Newton iteration contracts slowly or
+//! the step changed. A step whose Newton iteration fails even with a fresh matrix is retried at half
+//! the size; the step grows back after a few successes.
+//!
+//! First-order states that ride along (a controller, energy audits) are the system's business: it
+//! updates them from the step's endpoints ([`SecondOrderSystem::end_step`]), e.g. by the trapezoidal
+//! rule. Dense output is the cubic Hermite interpolant of the state and its derivative at both ends
+//! of the step (one right-hand-side evaluation per step), third order, above the method's own.
+
+use super::sparse::IterationMatrix;
+use super::{IntegratorError, OdeSystem, SolverStats, Stepper};
+
+/// A second-order system with a first-order tail, as the implicit integrator sees it.
+///
+/// State layout `[q (n) | q' (n) | tail]`; [`OdeSystem::rhs`] is the same system in first-order
+/// form (it gives the consistent initial acceleration and the dense output's derivatives).
+pub trait SecondOrderSystem: OdeSystem {
+    /// Number n of generalised coordinates q.
+    fn dofs(&self) -> usize;
+    /// The (row, col) entries of the iteration matrix that may be non-zero, fixed for the run.
+    fn iteration_pattern(&self) -> Vec<(usize, usize)>;
+    /// A step attempt from (t, y) of size h begins: the system records what its tail update and
+    /// its residual need from the step's start.
+    fn begin_step(&mut self, t: f64, y: &[f64], h: f64);
+    /// R = M(q) q'' − F(t, q, q', …) (n rows) for the iterate whose q, q' are `y[..2n]`.
+    fn residual(&mut self, t: f64, y: &[f64], qdd: &[f64], r: &mut [f64]);
+    /// S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q at the iterate, in the order of
+    /// [`Self::iteration_pattern`] (duplicates are summed). Returns the residual evaluations used.
+    #[allow(clippy::too_many_arguments)]
+    fn iteration_matrix(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        qdd: &[f64],
+        c_v: f64,
+        c_q: f64,
+        values: &mut [f64],
+    ) -> u64;
+    /// Writes the tail `y[2n..]` at the end t of an accepted step whose q, q' are `y[..2n]`.
+    fn end_step(&mut self, t: f64, y: &mut [f64]);
+}
+
+/// Settings of [`GeneralizedAlpha`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GeneralizedAlphaOptions {
+    /// Nominal step h [s].
+    pub step: f64,
+    /// Spectral radius at infinity ρ∞ ∈ [0, 1].
+    pub rho_inf: f64,
+    /// Newton converged at max |R| below this (MODELS.md §6: 1e-7 N).
+    pub newton_tol: f64,
+    /// Newton iterations allowed per matrix.
+    pub max_iterations: usize,
+    /// A residual shrinking by less than this factor per iteration counts as slow convergence: the
+    /// matrix is re-evaluated (modified Newton with a stale matrix contracts linearly).
+    pub slow_contraction: f64,
+    /// Smallest step before giving up [s].
+    pub min_step: f64,
+}
+
+impl Default for GeneralizedAlphaOptions {
+    fn default() -> Self {
+        Self {
+            step: 1e-4,
+            rho_inf: 0.9,
+            newton_tol: 1e-7,
+            max_iterations: 8,
+            slow_contraction: 0.5,
+            min_step: 1e-12,
+        }
+    }
+}
+
+/// Accepted steps at a reduced size after which the step is doubled back toward the nominal one.
+const SUCCESSES_BEFORE_GROWTH: u32 = 4;
+/// The matrix is re-evaluated when the step differs from the one it was built for by more than
+/// this ratio (its c_v, c_q scale with h and h²).
+const STEP_CHANGE_REFRESH: f64 = 0.25;
+
+/// The method's coefficients for ρ∞.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AlphaCoefficients {
+    pub alpha_m: f64,
+    pub alpha_f: f64,
+    pub gamma: f64,
+    pub beta: f64,
+}
+
+impl AlphaCoefficients {
+    /// Chung–Hulbert's optimal set for spectral radius ρ∞.
+    pub fn new(rho_inf: f64) -> Self {
+        let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
+        let alpha_f = rho_inf / (rho_inf + 1.0);
+        let gamma = 0.5 + alpha_f - alpha_m;
+        let beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
+        Self {
+            alpha_m,
+            alpha_f,
+            gamma,
+            beta,
+        }
+    }
+
+    /// (γ', β') = ∂(q', q)_{n+1}/∂q''_{n+1} for step h.
+    pub fn derivatives(&self, h: f64) -> (f64, f64) {
+        let k = (1.0 - self.alpha_f) / (1.0 - self.alpha_m);
+        (self.gamma * h * k, self.beta * h * h * k)
+    }
+}
+
+/// How one Newton solve ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Newton {
+    Converged,
+    Slow,
+    NonFinite(usize),
+}
+
+/// The generalised-α integrator with its buffers (allocated at [`Stepper::start`]).
+pub struct GeneralizedAlpha {
+    opts: GeneralizedAlphaOptions,
+    coeff: AlphaCoefficients,
+    n: usize,
+    t: f64,
+    t_prev: f64,
+    /// Target step (nominal, or reduced after failures) [s].
+    h: f64,
+    successes: u32,
+    y: Vec<f64>,
+    dy: Vec<f64>,
+    y_prev: Vec<f64>,
+    dy_prev: Vec<f64>,
+    /// True acceleration q''_n and algorithmic acceleration a_n.
+    qdd: Vec<f64>,
+    a: Vec<f64>,
+    // Iterate scratch.
+    y_try: Vec<f64>,
+    qdd_try: Vec<f64>,
+    a_try: Vec<f64>,
+    r: Vec<f64>,
+    values: Vec<f64>,
+    matrix: Option<IterationMatrix>,
+    /// Step the current factorisation was built for (0: none).
+    matrix_h: f64,
+    stats: SolverStats,
+}
+
+impl GeneralizedAlpha {
+    pub fn new(opts: GeneralizedAlphaOptions) -> Self {
+        Self {
+            coeff: AlphaCoefficients::new(opts.rho_inf),
+            opts,
+            n: 0,
+            t: 0.0,
+            t_prev: 0.0,
+            h: opts.step,
+            successes: 0,
+            y: Vec::new(),
+            dy: Vec::new(),
+            y_prev: Vec::new(),
+            dy_prev: Vec::new(),
+            qdd: Vec::new(),
+            a: Vec::new(),
+            y_try: Vec::new(),
+            qdd_try: Vec::new(),
+            a_try: Vec::new(),
+            r: Vec::new(),
+            values: Vec::new(),
+            matrix: None,
+            matrix_h: 0.0,
+            stats: SolverStats::default(),
+        }
+    }
+
+    /// Counters so far.
+    pub fn stats(&self) -> SolverStats {
+        self.stats
+    }
+
+    /// Time of the last accepted step [s].
+    pub fn time(&self) -> f64 {
+        self.t
+    }
+
+    /// State at [`Self::time`].
+    pub fn state(&self) -> &[f64] {
+        &self.y
+    }
+
+    /// Non-zeros of the factorised iteration matrix (0 before the start).
+    pub fn matrix_nonzeros(&self) -> usize {
+        self.matrix.as_ref().map_or(0, IterationMatrix::nonzeros)
+    }
+
+    /// The iterate's q, q' from q''_{n+1} = `qdd_try` (and a_{n+1} into `a_try`).
+    fn kinematics(&mut self, h: f64) {
+        let n = self.n;
+        let c = self.coeff;
+        let (q0, rest) = self.y.split_at(n);
+        let v0 = &rest[..n];
+        let (q1, rest) = self.y_try.split_at_mut(n);
+        let v1 = &mut rest[..n];
+        for i in 0..n {
+            let a1 = ((1.0 - c.alpha_f) * self.qdd_try[i] + c.alpha_f * self.qdd[i]
+                - c.alpha_m * self.a[i])
+                / (1.0 - c.alpha_m);
+            self.a_try[i] = a1;
+            q1[i] = q0[i] + h * v0[i] + h * h * ((0.5 - c.beta) * self.a[i] + c.beta * a1);
+            v1[i] = v0[i] + h * ((1.0 - c.gamma) * self.a[i] + c.gamma * a1);
+        }
+    }
+
+    /// Evaluates S at the current iterate for step h and factorises it.
+    fn refresh<S: SecondOrderSystem + ?Sized>(
+        &mut self,
+        sys: &mut S,
+        t: f64,
+        h: f64,
+    ) -> Result<(), IntegratorError> {
+        let (c_v, c_q) = self.coeff.derivatives(h);
+        let evals = sys.iteration_matrix(t, &self.y_try, &self.qdd_try, c_v, c_q, &mut self.values);
+        self.stats.rhs_evals += evals;
+        self.stats.jacobian_evals += 1;
+        let matrix = self
+            .matrix
+            .as_mut()
+            .ok_or(IntegratorError::Usage("step before start"))?;
+        matrix.factorise(&self.values)?;
+        self.stats.factorisations += 1;
+        self.matrix_h = h;
+        Ok(())
+    }
+
+    /// Modified Newton on q''_{n+1} from the current `qdd_try` with the current factorisation.
+    fn newton<S: SecondOrderSystem + ?Sized>(&mut self, sys: &mut S, t: f64, h: f64) -> Newton {
+        let mut previous = f64::INFINITY;
+        for _ in 0..=self.opts.max_iterations {
+            self.kinematics(h);
+            sys.residual(t, &self.y_try, &self.qdd_try, &mut self.r);
+            self.stats.rhs_evals += 1;
+            let mut norm = 0.0f64;
+            for (i, r) in self.r.iter().enumerate() {
+                if !r.is_finite() {
+                    return Newton::NonFinite(i);
+                }
+                norm = norm.max(r.abs());
+            }
+            if norm <= self.opts.newton_tol {
+                return Newton::Converged;
+            }
+            if norm > self.opts.slow_contraction * previous {
+                return Newton::Slow;
+            }
+            previous = norm;
+            let Some(matrix) = self.matrix.as_mut() else {
+                return Newton::Slow;
+            };
+            matrix.solve_in_place(&mut self.r);
+            for (q, d) in self.qdd_try.iter_mut().zip(&self.r) {
+                *q -= d;
+            }
+            self.stats.newton_iterations += 1;
+        }
+        Newton::Slow
+    }
+
+    /// Size of the step to attempt toward `t_end`: the target, or the remainder if that is within
+    /// a hair of it (no sliver steps at the end).
+    fn step_to(&self, t_end: f64) -> f64 {
+        let remaining = t_end - self.t;
+        if remaining <= self.h * (1.0 + 1e-6) {
+            remaining
+        } else {
+            self.h
+        }
+    }
+
+    fn initialise<S: SecondOrderSystem + ?Sized>(&mut self, sys: &mut S, t: f64, y: &[f64]) {
+        let n = self.n;
+        self.t = t;
+        self.t_prev = t;
+        self.y.copy_from_slice(y);
+        sys.rhs(t, &self.y, &mut self.dy);
+        self.stats.rhs_evals += 1;
+        self.qdd.copy_from_slice(&self.dy[n..2 * n]);
+        self.a.copy_from_slice(&self.qdd);
+        self.y_prev.copy_from_slice(&self.y);
+        self.dy_prev.copy_from_slice(&self.dy);
+    }
+}
+
+impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
+    fn start(
+        &mut self,
+        sys: &mut S,
+        t0: f64,
+        y0: &[f64],
+        t_end: f64,
+    ) -> Result<(), IntegratorError> {
+        let dim = sys.dimension();
+        let n = sys.dofs();
+        if y0.len() != dim || 2 * n > dim {
+            return Err(IntegratorError::Usage(
+                "state length differs from the system's dimension",
+            ));
+        }
+        if t_end <= t0 {
+            return Err(IntegratorError::Usage("t_end must be after t0"));
+        }
+        if !(self.opts.step > 0.0 && (0.0..=1.0).contains(&self.opts.rho_inf)) {
+            return Err(IntegratorError::Usage(
+                "step must be > 0 and rho_inf in [0, 1]",
+            ));
+        }
+        self.n = n;
+        for v in [
+            &mut self.y,
+            &mut self.dy,
+            &mut self.y_prev,
+            &mut self.dy_prev,
+            &mut self.y_try,
+        ] {
+            *v = vec![0.0; dim];
+        }
+        for v in [
+            &mut self.qdd,
+            &mut self.a,
+            &mut self.qdd_try,
+            &mut self.a_try,
+            &mut self.r,
+        ] {
+            *v = vec![0.0; n];
+        }
+        let pattern = sys.iteration_pattern();
+        self.values = vec![0.0; pattern.len()];
+        self.matrix = Some(IterationMatrix::new(n, &pattern)?);
+        self.matrix_h = 0.0;
+        self.h = self.opts.step;
+        self.stats = SolverStats::default();
+        self.initialise(sys, t0, y0);
+        Ok(())
+    }
+
+    fn step(&mut self, sys: &mut S, t_end: f64) -> Result<(), IntegratorError> {
+        if self.matrix.is_none() {
+            return Err(IntegratorError::Usage("step before start"));
+        }
+        if t_end <= self.t {
+            return Err(IntegratorError::Usage(
+                "t_end must be after the current time",
+            ));
+        }
+        let n = self.n;
+        loop {
+            let h = self.step_to(t_end);
+            if h < self.opts.min_step {
+                return Err(IntegratorError::StepSizeUnderflow { t: self.t, h });
+            }
+            let last = h == t_end - self.t;
+            let t1 = if last { t_end } else { self.t + h };
+            sys.begin_step(self.t, &self.y, h);
+            self.y_try.copy_from_slice(&self.y);
+            self.qdd_try.copy_from_slice(&self.qdd);
+            let mut fresh = false;
+            if self.matrix_h == 0.0 || (self.matrix_h / h - 1.0).abs() > STEP_CHANGE_REFRESH {
+                self.kinematics(h);
+                self.refresh(sys, t1, h)?;
+                fresh = true;
+            }
+            let mut outcome = self.newton(sys, t1, h);
+            if outcome == Newton::Slow && !fresh {
+                // Re-evaluate the matrix at the current iterate and start over from the predictor.
+                self.refresh(sys, t1, h)?;
+                self.qdd_try.copy_from_slice(&self.qdd);
+                outcome = self.newton(sys, t1, h);
+            }
+            self.stats.steps_attempted += 1;
+            match outcome {
+                Newton::Converged => {}
+                failed => {
+                    self.stats.steps_rejected += 1;
+                    self.successes = 0;
+                    self.h = 0.5 * h;
+                    if self.h < self.opts.min_step {
+                        return Err(match failed {
+                            Newton::NonFinite(component) => IntegratorError::NonFinite {
+                                t: self.t,
+                                component,
+                            },
+                            _ => IntegratorError::StepSizeUnderflow {
+                                t: self.t,
+                                h: self.h,
+                            },
+                        });
+                    }
+                    continue;
+                }
+            }
+            self.y_prev.copy_from_slice(&self.y);
+            self.dy_prev.copy_from_slice(&self.dy);
+            self.y[..2 * n].copy_from_slice(&self.y_try[..2 * n]);
+            sys.end_step(t1, &mut self.y);
+            self.t_prev = self.t;
+            self.t = t1;
+            std::mem::swap(&mut self.qdd, &mut self.qdd_try);
+            std::mem::swap(&mut self.a, &mut self.a_try);
+            sys.rhs(self.t, &self.y, &mut self.dy);
+            self.stats.rhs_evals += 1;
+            self.stats.steps_accepted += 1;
+            if self.h < self.opts.step {
+                self.successes += 1;
+                if self.successes >= SUCCESSES_BEFORE_GROWTH {
+                    self.h = (2.0 * self.h).min(self.opts.step);
+                    self.successes = 0;
+                }
+            }
+            return Ok(());
+        }
+    }
+
+    fn restart(&mut self, sys: &mut S, t: f64, y: &[f64]) {
+        self.initialise(sys, t, y);
+        self.stats.restarts += 1;
+    }
+
+    fn time(&self) -> f64 {
+        GeneralizedAlpha::time(self)
+    }
+
+    fn previous_time(&self) -> f64 {
+        self.t_prev
+    }
+
+    fn state(&self) -> &[f64] {
+        GeneralizedAlpha::state(self)
+    }
+
+    /// Cubic Hermite interpolation of y from (y, y') at both ends of the last step.
+    fn dense_output(&self, t: f64, out: &mut [f64]) {
+        let h = self.t - self.t_prev;
+        if h <= 0.0 {
+            out.copy_from_slice(&self.y[..out.len()]);
+            return;
+        }
+        let s = (t - self.t_prev) / h;
+        let s2 = s * s;
+        let s3 = s2 * s;
+        let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
+        let h10 = (s3 - 2.0 * s2 + s) * h;
+        let h01 = -2.0 * s3 + 3.0 * s2;
+        let h11 = (s3 - s2) * h;
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = h00 * self.y_prev[i] + h10 * self.dy_prev[i] + h01 * self.y[i] + h11 * self.dy[i];
+        }
+    }
+
+    fn stats(&self) -> SolverStats {
+        GeneralizedAlpha::stats(self)
+    }
+}

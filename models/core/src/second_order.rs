@@ -1,0 +1,227 @@
+//! The second-order form of a cable model, R(q, q', q'', T) = M(q) q'' − F(q, q', T) = 0, which the
+//! implicit integrator needs (MODELS.md §6, FE.9.3), and the finite-difference iteration matrix over
+//! a declared sparsity pattern for models without an analytic one.
+//!
+//! A model offering this form keeps its state as `[q (n) | q' (n)]`. The residual is in the units of
+//! the generalised forces (N for node coordinates), so one Newton tolerance (1e-7 N) serves every
+//! model. The tensions enter R linearly; the closed loop adds their dependence on the effector
+//! through the controller, so a model never sees the controller.
+
+/// M(q) q'' − F(q, q', T) of a model, with its iteration matrix.
+pub trait SecondOrderForm {
+    /// Number n of generalised coordinates.
+    fn dofs(&self) -> usize;
+    /// Index of the effector's x among q.
+    fn effector_x(&self) -> usize;
+    /// Rows of R in which a commanded tension may appear (the closed loop couples them to the
+    /// effector's x through the controller).
+    fn tension_rows(&self) -> Vec<usize>;
+    /// The (row, col) entries of ∂R/∂q'', ∂R/∂q' and ∂R/∂q that may be non-zero, for every state
+    /// the model can reach (so one symbolic factorisation serves the run).
+    fn iteration_pattern(&self) -> Vec<(usize, usize)>;
+    /// R = M(q) q'' − F(q, q', T) for state `[q | q']` into `r` (n).
+    fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]);
+    /// S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q at fixed tensions, in the order of
+    /// [`Self::iteration_pattern`]. Returns the residual evaluations it used (0 if analytic).
+    #[allow(clippy::too_many_arguments)]
+    fn iteration_matrix(
+        &mut self,
+        state: &[f64],
+        qdd: &[f64],
+        tensions: [f64; 2],
+        c_v: f64,
+        c_q: f64,
+        values: &mut [f64],
+    ) -> u64;
+}
+
+/// Finite-difference iteration matrix over a sparsity pattern, with the columns grouped so that no
+/// two columns of a group share a row (Curtis, Powell & Reid 1974): one residual evaluation per group
+/// and per derivative (q'', q', q) instead of one per column.
+///
+/// Steps: R is linear in q'', so δq''_j = max(1, |q''_j|) is exact up to round-off; for q and q'
+/// forward differences with δ_j = √ε·max(|u_j|, u_typ) balance truncation (∝ δ) and round-off
+/// (∝ ε/δ) at about √ε ≈ 1.5e-8 relative, ample for a Newton matrix (it changes the convergence
+/// rate, never the converged answer).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ColouredDifferences {
+    n: usize,
+    /// Columns of each group.
+    groups: Vec<Vec<usize>>,
+    /// Per column: (row, index into the pattern) of its distinct entries.
+    column_entries: Vec<Vec<(usize, usize)>>,
+    base: Vec<f64>,
+    probe: Vec<f64>,
+    state: Vec<f64>,
+    qdd: Vec<f64>,
+    steps: Vec<f64>,
+}
+
+/// R(state, q'') into the last argument, at fixed tensions.
+pub type ResidualFn<'a> = dyn FnMut(&[f64], &[f64], &mut [f64]) + 'a;
+
+/// Typical magnitude of a coordinate [m] and a velocity [m/s] below which the FD step stops
+/// shrinking (a node at z = 0 still gets a step of ~1e-10 m).
+const TYPICAL_COORDINATE: f64 = 1e-2;
+
+impl ColouredDifferences {
+    /// Groups the columns of the n × n `pattern` greedily (first fit, column order).
+    pub fn new(n: usize, pattern: &[(usize, usize)]) -> Self {
+        let mut column_entries: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n];
+        let mut rows: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for (k, &(r, c)) in pattern.iter().enumerate() {
+            if r >= n || c >= n || column_entries[c].iter().any(|&(rr, _)| rr == r) {
+                continue;
+            }
+            column_entries[c].push((r, k));
+            rows[r].push(c);
+        }
+        let mut colour = vec![usize::MAX; n];
+        let mut groups: Vec<Vec<usize>> = Vec::new();
+        let mut taken = Vec::new();
+        for c in 0..n {
+            taken.clear();
+            for &(r, _) in &column_entries[c] {
+                taken.extend(rows[r].iter().map(|&other| colour[other]));
+            }
+            let g = (0..).find(|g| !taken.contains(g)).unwrap_or(0);
+            colour[c] = g;
+            if g == groups.len() {
+                groups.push(Vec::new());
+            }
+            groups[g].push(c);
+        }
+        Self {
+            n,
+            groups,
+            column_entries,
+            base: vec![0.0; n],
+            probe: vec![0.0; n],
+            state: vec![0.0; 2 * n],
+            qdd: vec![0.0; n],
+            steps: vec![0.0; n],
+        }
+    }
+
+    /// Number of column groups (residual evaluations per derivative).
+    pub fn groups(&self) -> usize {
+        self.groups.len()
+    }
+
+    /// S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q of `residual(state, qdd, r)` at (state, qdd) into
+    /// `values` (pattern order; duplicate entries get 0). Returns the residual evaluations used.
+    #[allow(clippy::too_many_arguments)]
+    pub fn fill(
+        &mut self,
+        residual: &mut ResidualFn<'_>,
+        state: &[f64],
+        qdd: &[f64],
+        c_v: f64,
+        c_q: f64,
+        values: &mut [f64],
+    ) -> u64 {
+        let n = self.n;
+        values.fill(0.0);
+        self.state.copy_from_slice(&state[..2 * n]);
+        self.qdd.copy_from_slice(qdd);
+        residual(&self.state, &self.qdd, &mut self.base);
+        let mut evals = 1;
+        // Derivative 0: q'' (weight 1), 1: q' (c_v), 2: q (c_q).
+        for (derivative, weight) in [(0usize, 1.0), (1, c_v), (2, c_q)] {
+            if weight == 0.0 {
+                continue;
+            }
+            for g in 0..self.groups.len() {
+                for &c in &self.groups[g] {
+                    let (slot, typical) = match derivative {
+                        0 => (&mut self.qdd[c], f64::NAN),
+                        1 => (&mut self.state[n + c], TYPICAL_COORDINATE),
+                        _ => (&mut self.state[c], TYPICAL_COORDINATE),
+                    };
+                    let step = if derivative == 0 {
+                        slot.abs().max(1.0)
+                    } else {
+                        f64::EPSILON.sqrt() * slot.abs().max(typical)
+                    };
+                    let before = *slot;
+                    *slot += step;
+                    // The step actually taken, after rounding.
+                    self.steps[c] = *slot - before;
+                }
+                residual(&self.state, &self.qdd, &mut self.probe);
+                evals += 1;
+                for &c in &self.groups[g] {
+                    let scale = weight / self.steps[c];
+                    for &(r, k) in &self.column_entries[c] {
+                        values[k] += scale * (self.probe[r] - self.base[r]);
+                    }
+                    match derivative {
+                        0 => self.qdd[c] = qdd[c],
+                        1 => self.state[n + c] = state[n + c],
+                        _ => self.state[c] = state[c],
+                    }
+                }
+            }
+        }
+        evals
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A chain of unit masses with springs k between neighbours and dampers c, plus a nonlinear
+    /// cubic term: S from the differences against the hand-derived one.
+    #[test]
+    fn coloured_differences_match_the_analytic_chain_matrix() {
+        let n = 7;
+        let (k, c, m) = (3.0e4, 2.0, 0.5);
+        let residual = |s: &[f64], a: &[f64], r: &mut [f64]| {
+            let (q, v) = s.split_at(n);
+            for i in 0..n {
+                let mut f = 0.0;
+                if i > 0 {
+                    f -= k * (q[i] - q[i - 1]) + c * (v[i] - v[i - 1]);
+                }
+                if i + 1 < n {
+                    f += k * (q[i + 1] - q[i]) + c * (v[i + 1] - v[i]);
+                }
+                f -= q[i].powi(3);
+                r[i] = m * a[i] - f;
+            }
+        };
+        let mut pattern = Vec::new();
+        for i in 0..n {
+            for j in i.saturating_sub(1)..(i + 2).min(n) {
+                pattern.push((i, j));
+            }
+        }
+        let mut fd = ColouredDifferences::new(n, &pattern);
+        assert_eq!(fd.groups(), 3, "a tridiagonal pattern needs three groups");
+        let state: Vec<f64> = (0..2 * n).map(|i| 0.1 * i as f64 - 0.3).collect();
+        let qdd: Vec<f64> = (0..n).map(|i| i as f64).collect();
+        let (c_v, c_q) = (5e-5, 2.5e-9);
+        let mut values = vec![0.0; pattern.len()];
+        let mut f = residual;
+        let evals = fd.fill(&mut f, &state, &qdd, c_v, c_q, &mut values);
+        assert_eq!(evals, 1 + 3 * 3);
+        for (idx, &(i, j)) in pattern.iter().enumerate() {
+            let off = (i as isize - j as isize).abs() == 1;
+            let deg = (i > 0) as usize + (i + 1 < n) as usize;
+            let exact = if i == j {
+                m + c_v * c * deg as f64 + c_q * (k * deg as f64 + 3.0 * state[i].powi(2))
+            } else if off {
+                -c_v * c - c_q * k
+            } else {
+                0.0
+            };
+            // Forward differences: relative error ~√ε·(curvature) ≈ 1e-8 of the largest term.
+            assert!(
+                (values[idx] - exact).abs() <= 1e-7 * exact.abs().max(m),
+                "({i}, {j}): {} vs {exact}",
+                values[idx]
+            );
+        }
+    }
+}
