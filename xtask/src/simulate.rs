@@ -64,12 +64,15 @@ pub fn run(scenario: Option<&Path>, model: Option<&str>, out: &Path, every: usiz
         },
     )?;
     println!(
-        "{}: {} samples, {} RHS evaluations, {} accepted / {} rejected steps, {} events, {:.3} s wall → {}",
+        "{}: {} samples, {} RHS evaluations, {} accepted / {} rejected steps, {} Newton iterations, {} matrix evaluations, {} factorisations, {} events, {:.3} s wall → {}",
         run.model,
         run.series.len(),
         run.stats.rhs_evals,
         run.stats.steps_accepted,
         run.stats.steps_rejected,
+        run.stats.newton_iterations,
+        run.stats.jacobian_evals,
+        run.stats.factorisations,
         run.events.len(),
         run.wall_s,
         out.display()

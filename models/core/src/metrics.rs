@@ -87,6 +87,11 @@ pub struct Metrics {
     pub rhs_evals: u64,
     pub steps_accepted: u64,
     pub steps_rejected: u64,
+    /// Implicit path only (0 for DOPRI5): Newton iterations, iteration-matrix evaluations and
+    /// numeric LU factorisations.
+    pub newton_iterations: u64,
+    pub jacobian_evals: u64,
+    pub factorisations: u64,
     pub wall_s: f64,
 }
 
@@ -243,6 +248,9 @@ impl Metrics {
             rhs_evals: run.stats.rhs_evals,
             steps_accepted: run.stats.steps_accepted,
             steps_rejected: run.stats.steps_rejected,
+            newton_iterations: run.stats.newton_iterations,
+            jacobian_evals: run.stats.jacobian_evals,
+            factorisations: run.stats.factorisations,
             wall_s: run.wall_s,
         }
     }

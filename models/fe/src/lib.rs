@@ -20,6 +20,7 @@
 
 pub mod chain;
 pub mod element;
+mod implicit;
 pub mod solve;
 mod statics;
 
@@ -468,6 +469,14 @@ impl CableModel for Fe {
 
     fn channel_names(&self) -> Vec<String> {
         cdpr_core::model::CABLE_CHANNELS.map(String::from).to_vec()
+    }
+
+    fn second_order(&self) -> Option<&dyn cdpr_core::second_order::SecondOrderForm> {
+        Some(self)
+    }
+
+    fn second_order_mut(&mut self) -> Option<&mut dyn cdpr_core::second_order::SecondOrderForm> {
+        Some(self)
     }
 
     /// Element tensions N_N (at the effector) and N_1 (at the pulley) [N], free unstrained lengths

@@ -1,0 +1,277 @@
+//! The FE model's second-order form for the implicit integrator (MODELS.md FE.9.3):
+//! R = M(q) q'' − F(q, q', T) from the same assembly as the explicit right-hand side, and the
+//! iteration matrix S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q element by element.
+//!
+//! Why element by element: the rows l_i are dense (every node of a span feeds its length's
+//! equation), so colouring the columns of the global matrix would need one residual per column,
+//! O(N²) per matrix. Each element's contribution, though, depends only on its own unknowns
+//! (r_a, r_b, l for a free element; ρ, l for the stored one), so differentiating the element kernel
+//! ([`element::terms`]) in its 5 local unknowns and adding the 5 × 5 blocks gives the exact
+//! global pattern of FE.5.5 (block-tridiagonal with the border rows and columns) at O(N) cost.
+//! Forward differences with δ = √ε·max(|u|, 1e-2) are accurate to ~1e-8 relative, ample for a
+//! Newton matrix; the derivative in q'' is linear and exact.
+
+use crate::element::{self, ElementState};
+use crate::{E_OUT, Fe};
+use cdpr_core::second_order::SecondOrderForm;
+use nalgebra::Vector2;
+
+/// One additive block of R: an element, the rigid stored cable or the effector.
+#[derive(Debug, Clone, Copy)]
+enum Block {
+    /// Free element e (1…N) of a cable: local (x_a, z_a, x_b, z_b, l).
+    Free { cable: usize, e: usize },
+    /// The elastic stored element: local (ρ, l).
+    Stored { cable: usize },
+    /// The rigid stored cable: local (l).
+    Rigid { cable: usize },
+    /// The effector's own mass and weight: local (x_P, z_P).
+    Effector,
+}
+
+/// Local unknowns of a block (at most 5) and their global indices (None: a fixed pulley node).
+type LocalDofs = [Option<usize>; 5];
+
+/// Smallest magnitude the finite-difference step is scaled to [m, m/s].
+const TYPICAL: f64 = 1e-2;
+
+impl Fe {
+    fn blocks(&self) -> Vec<Block> {
+        let mut blocks = Vec::with_capacity(2 * self.elements + 3);
+        for cable in 0..2 {
+            blocks.extend((1..=self.elements).map(|e| Block::Free { cable, e }));
+            blocks.push(match self.rho_index(cable) {
+                Some(_) => Block::Stored { cable },
+                None => Block::Rigid { cable },
+            });
+        }
+        blocks.push(Block::Effector);
+        blocks
+    }
+
+    fn block_dofs(&self, block: Block) -> (LocalDofs, usize) {
+        let nn = self.chain_nodes();
+        match block {
+            Block::Free { cable, e } => {
+                let ja = self.chain_index(cable, e - 1);
+                let jb = self.chain_index(cable, e);
+                (
+                    [
+                        ja,
+                        ja.map(|j| nn + j),
+                        jb,
+                        jb.map(|j| nn + j),
+                        Some(self.l_index(cable)),
+                    ],
+                    5,
+                )
+            }
+            Block::Stored { cable } => (
+                [
+                    self.rho_index(cable),
+                    Some(self.l_index(cable)),
+                    None,
+                    None,
+                    None,
+                ],
+                2,
+            ),
+            Block::Rigid { cable } => ([Some(self.l_index(cable)), None, None, None, None], 1),
+            Block::Effector => {
+                let p = self.effector_index();
+                ([Some(p), Some(nn + p), None, None, None], 2)
+            }
+        }
+    }
+
+    /// The block's part of R (tension terms left out: they do not depend on the unknowns) for
+    /// local positions `q`, velocities `v`, accelerations `a`.
+    fn block_residual(&self, block: Block, q: &[f64; 5], v: &[f64; 5], a: &[f64; 5]) -> [f64; 5] {
+        let mat = &self.material;
+        let mut r = [0.0; 5];
+        match block {
+            Block::Free { cable: _, e } => {
+                let n = self.elements as f64;
+                let s = ElementState {
+                    ra: Vector2::new(q[0], q[1]),
+                    rb: Vector2::new(q[2], q[3]),
+                    va: Vector2::new(v[0], v[1]),
+                    vb: Vector2::new(v[2], v[3]),
+                    l_rate: v[4],
+                    h: q[4] / n,
+                    h_prime: 1.0 / n,
+                };
+                let t = element::terms(mat, &self.coefficients[e - 1], &s);
+                let (aa, ab) = (Vector2::new(a[0], a[1]), Vector2::new(a[2], a[3]));
+                let ra = aa * t.m_diag + ab * t.m_off + t.m_al * a[4] - t.fa;
+                let rb = aa * t.m_off + ab * t.m_diag + t.m_bl * a[4] - t.fb;
+                r[..4].copy_from_slice(&[ra.x, ra.y, rb.x, rb.y]);
+                r[4] = t.m_al.dot(&aa) + t.m_bl.dot(&ab) + t.m_ll * a[4] - t.fl;
+            }
+            Block::Stored { cable } => {
+                let e_out = Vector2::new(E_OUT[cable], 0.0);
+                let pulley = self.pulley(cable);
+                let s = ElementState {
+                    ra: pulley + e_out * q[0],
+                    rb: pulley,
+                    va: e_out * v[0],
+                    vb: Vector2::zeros(),
+                    l_rate: v[1],
+                    h: self.modelled_length - q[1],
+                    h_prime: -1.0,
+                };
+                let t = element::terms(mat, &self.stored_coefficients, &s);
+                let m_rho_l = t.m_al.dot(&e_out);
+                r[0] = t.m_diag * a[0] + m_rho_l * a[1] - t.fa.dot(&e_out);
+                r[1] = m_rho_l * a[0] + t.m_ll * a[1] - t.fl;
+            }
+            Block::Rigid { .. } => {
+                r[0] = mat.mu * (self.modelled_length - q[0]) * a[0] - 0.5 * mat.mu * v[0] * v[0];
+            }
+            Block::Effector => {
+                r[0] = self.effector_mass * a[0];
+                r[1] = self.effector_mass * (a[1] + mat.gravity);
+            }
+        }
+        r
+    }
+
+    /// The block's local unknowns from the global state; a fixed pulley node sits at A_i at rest.
+    fn gather(&self, block: Block, dofs: &LocalDofs, state: &[f64], qdd: &[f64]) -> [[f64; 5]; 3] {
+        let np = self.positions_len();
+        let mut local = [[0.0; 5]; 3];
+        for (k, dof) in dofs.iter().enumerate() {
+            match dof {
+                Some(g) => {
+                    local[0][k] = state[*g];
+                    local[1][k] = state[np + g];
+                    local[2][k] = qdd[*g];
+                }
+                None => {
+                    if let (Block::Free { cable, .. }, 0 | 1) = (block, k) {
+                        local[0][k] = self.pulley(cable)[k];
+                    }
+                }
+            }
+        }
+        local
+    }
+}
+
+impl SecondOrderForm for Fe {
+    fn dofs(&self) -> usize {
+        self.positions_len()
+    }
+
+    fn effector_x(&self) -> usize {
+        self.effector_index()
+    }
+
+    /// T_i pulls the reel end (row ρ_i), or the rigid stored cable through l_i.
+    fn tension_rows(&self) -> Vec<usize> {
+        (0..2)
+            .map(|c| self.rho_index(c).unwrap_or(self.l_index(c)))
+            .collect()
+    }
+
+    fn iteration_pattern(&self) -> Vec<(usize, usize)> {
+        let mut pattern = Vec::new();
+        for block in self.blocks() {
+            let (dofs, len) = self.block_dofs(block);
+            for row in dofs[..len].iter().flatten() {
+                for col in dofs[..len].iter().flatten() {
+                    pattern.push((*row, *col));
+                }
+            }
+        }
+        pattern
+    }
+
+    /// M q'' − F on the assembly of FE.5.5 (before its solve): the tridiagonal node blocks, the
+    /// l-columns C and the border block D.
+    fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]) {
+        self.assemble(state, tensions);
+        let s = &self.system;
+        let nn = self.chain_nodes();
+        let [l1, l2] = [0, 1].map(|c| 2 * nn + s.l_index[c]);
+        let mut border_acc = [0.0; 2];
+        for j in 0..nn {
+            let c = &s.rhs[j];
+            for axis in 0..2 {
+                let i = axis * nn + j;
+                let mut m_qdd = s.diag[j] * qdd[i] + c[2 + axis] * qdd[l1] + c[4 + axis] * qdd[l2];
+                if j > 0 {
+                    m_qdd += s.off[j - 1] * qdd[i - 1];
+                }
+                if j + 1 < nn {
+                    m_qdd += s.off[j] * qdd[i + 1];
+                }
+                r[i] = m_qdd - c[axis];
+                border_acc[0] += c[2 + axis] * qdd[i];
+                border_acc[1] += c[4 + axis] * qdd[i];
+            }
+        }
+        for b in 0..s.border {
+            let mut m_qdd: f64 = (0..s.border).map(|k| s.d[b][k] * qdd[2 * nn + k]).sum();
+            if b == s.l_index[0] {
+                m_qdd += border_acc[0];
+            }
+            if b == s.l_index[1] {
+                m_qdd += border_acc[1];
+            }
+            r[2 * nn + b] = m_qdd - s.f_border[b];
+        }
+    }
+
+    fn iteration_matrix(
+        &mut self,
+        state: &[f64],
+        qdd: &[f64],
+        _tensions: [f64; 2],
+        c_v: f64,
+        c_q: f64,
+        values: &mut [f64],
+    ) -> u64 {
+        let mut at = 0;
+        for block in self.blocks() {
+            let (dofs, len) = self.block_dofs(block);
+            let [q, v, a] = self.gather(block, &dofs, state, qdd);
+            let base = self.block_residual(block, &q, &v, &a);
+            // local[row][col] of S.
+            let mut local = [[0.0; 5]; 5];
+            for col in 0..len {
+                if dofs[col].is_none() {
+                    continue;
+                }
+                for (which, weight) in [(0, c_q), (1, c_v), (2, 1.0)] {
+                    let mut u = [q, v, a];
+                    let x = u[which][col];
+                    let step = if which == 2 {
+                        x.abs().max(1.0)
+                    } else {
+                        f64::EPSILON.sqrt() * x.abs().max(TYPICAL)
+                    };
+                    u[which][col] = x + step;
+                    let step = u[which][col] - x;
+                    let probe = self.block_residual(block, &u[0], &u[1], &u[2]);
+                    for row in 0..len {
+                        local[row][col] += weight * (probe[row] - base[row]) / step;
+                    }
+                }
+            }
+            for row in 0..len {
+                if dofs[row].is_none() {
+                    continue;
+                }
+                for col in 0..len {
+                    if dofs[col].is_some() {
+                        values[at] = local[row][col];
+                        at += 1;
+                    }
+                }
+            }
+        }
+        // One base and 3 × 5 probes per block: the cost of about 16 residual sweeps.
+        16
+    }
+}
