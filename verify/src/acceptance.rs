@@ -31,6 +31,9 @@ pub struct ModelResult<'a> {
     pub metrics: &'a Metrics,
     /// Closed-loop vertical eigenfrequency at the x2 equilibrium [rad/s].
     pub vertical_mode: f64,
+    /// The lowest closed-loop axial mode (lumped, ≈ 5649 rad/s) as the run's integrator renders it
+    /// [rad/s]: generalised-α shifts it (period elongation), DOPRI5 does not.
+    pub axial_mode: f64,
 }
 
 fn check(
@@ -180,16 +183,26 @@ pub fn model_checks(r: &ModelResult) -> Vec<Check> {
             let axial = m
                 .err_hf_peaks
                 .iter()
-                .find(|[w, db]| (w / LUMPED_AXIAL_MODE - 1.0).abs() <= 0.02 && *db >= -40.0);
+                .find(|[w, db]| (w / r.axial_mode - 1.0).abs() <= 0.02 && *db >= -40.0);
+            let target = if r.axial_mode == LUMPED_AXIAL_MODE {
+                format!("{LUMPED_AXIAL_MODE} rad/s")
+            } else {
+                format!(
+                    "{:.1} rad/s (the implicit step's image of {LUMPED_AXIAL_MODE} rad/s)",
+                    r.axial_mode
+                )
+            };
             check(
                 "high-frequency content of the error spectrum",
                 name,
                 "extra peaks (cable discretisation)",
                 match axial {
                     Some([w, db]) => format!("{w:.1} rad/s at {db:.1} dB (largest: {hf})"),
-                    None => format!("none near {LUMPED_AXIAL_MODE} rad/s (largest: {hf})"),
+                    None => format!("none near {target} (largest: {hf})"),
                 },
-                "a local maximum within ±2 % of the lowest closed-loop axial mode (≈ 5649 rad/s) at ≥ −40 dB",
+                &format!(
+                    "a local maximum within ±2 % of the lowest closed-loop axial mode, {target}, at ≥ −40 dB"
+                ),
                 axial.is_some(),
             )
         }

@@ -246,3 +246,66 @@ fn rho_one_keeps_the_oscillator_amplitude() {
     assert_eq!(s.steps_accepted, 200);
     assert_eq!(s.steps_rejected, 0);
 }
+
+/// The discrete frequency and growth `discrete_mode` predicts against a long integration of the
+/// oscillator: the zero crossings give the frequency, the amplitude ratio the growth. ω h = 0.56,
+/// the lumped axial mode at the paper's step (MODELS.md FE.9.3 quotes 5731 rad/s for FE's 5895).
+#[test]
+fn discrete_mode_matches_the_integrated_oscillator() {
+    use cdpr_core::integrate::AlphaCoefficients;
+    let (omega, h, rho_inf) = (5649.0, 1e-4, 0.9);
+    let (predicted, growth) = AlphaCoefficients::new(rho_inf).discrete_mode(omega, h);
+    assert!((predicted - 5503.85).abs() < 0.1, "{predicted}");
+    assert!((growth + 0.0685).abs() < 1e-3, "{growth}");
+    let mut sys = Oscillator {
+        m: 1.0,
+        k: omega * omega,
+        h: 0.0,
+        start: (0.0, 0.0),
+    };
+    let mut ga = GeneralizedAlpha::new(GeneralizedAlphaOptions {
+        step: h,
+        rho_inf,
+        newton_tol: 1e-3,
+        ..GeneralizedAlphaOptions::default()
+    });
+    let t_end = 2.0;
+    ga.start(&mut sys, 0.0, &[1.0, 0.0, 0.0], t_end).unwrap();
+    // Upward zero crossings of q, by linear interpolation between steps, after the spurious root
+    // (|λ| ≈ 0.8 per step) has died out.
+    let mut crossings = Vec::new();
+    let (mut t_prev, mut q_prev) = (0.0, 1.0);
+    let mut samples = Vec::new();
+    while ga.time() < t_end {
+        ga.step(&mut sys, t_end).unwrap();
+        let (t, q) = (ga.time(), ga.state()[0]);
+        if t > 0.01 && q_prev < 0.0 && q >= 0.0 {
+            crossings.push(t_prev + (t - t_prev) * (-q_prev) / (q - q_prev));
+        }
+        samples.push((t, q));
+        (t_prev, q_prev) = (t, q);
+    }
+    let periods = (crossings.len() - 1) as f64;
+    let measured =
+        2.0 * std::f64::consts::PI * periods / (crossings[crossings.len() - 1] - crossings[0]);
+    // Interpolated crossings err by O((ωh)²) of a step each, spread over ~1800 periods: 1e-3 relative.
+    assert!(
+        (measured / predicted - 1.0).abs() < 1e-3,
+        "{measured} vs {predicted}"
+    );
+    // Amplitude ∝ RMS of q over 0.1 s windows (~90 periods, so the sampling phase averages out).
+    let rms = |a: f64, b: f64| {
+        let w: Vec<f64> = samples
+            .iter()
+            .filter(|(t, _)| (a..b).contains(t))
+            .map(|s| s.1)
+            .collect();
+        (w.iter().map(|q| q * q).sum::<f64>() / w.len() as f64).sqrt()
+    };
+    let measured_growth = (rms(1.9, 2.0) / rms(0.01, 0.11)).ln() / 1.89;
+    // The windows' RMS carries ~1 % sampling-phase noise; over a 13 % decay that is 5 % of the rate.
+    assert!(
+        (measured_growth / growth - 1.0).abs() < 0.05,
+        "{measured_growth} vs {growth}"
+    );
+}

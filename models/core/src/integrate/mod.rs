@@ -9,7 +9,9 @@ mod generalized_alpha;
 pub mod sparse;
 
 pub use dopri5::{Dopri5, Dopri5Options};
-pub use generalized_alpha::{GeneralizedAlpha, GeneralizedAlphaOptions, SecondOrderSystem};
+pub use generalized_alpha::{
+    AlphaCoefficients, GeneralizedAlpha, GeneralizedAlphaOptions, SecondOrderSystem,
+};
 
 /// A first-order system y' = f(t, y) of fixed dimension.
 pub trait OdeSystem {
