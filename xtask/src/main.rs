@@ -1,7 +1,8 @@
 //! `cargo xtask`: the cdpr-bench command line.
 //!
 //! - `simulate`: one scenario → `timeseries.csv` and `metrics.json`;
-//! - `report`: the paper scenario for every available model → `REPORT.md` and `metrics.json`.
+//! - `report`: the paper scenario for every available model → `REPORT.md` and `metrics.json`;
+//! - `work-precision`: error vs cost of DOPRI5 and generalised-α on the massive-cable models.
 //!
 //! Errors are printed for a person and give a non-zero exit; a failed run keeps its output.
 
@@ -9,6 +10,7 @@ mod figures;
 mod output;
 mod report;
 mod simulate;
+mod work_precision;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -50,6 +52,13 @@ enum Command {
         #[arg(long)]
         scenario: Option<PathBuf>,
     },
+    /// Error of the effector trajectory vs cost for DOPRI5 and the implicit path (lumped, FE):
+    /// DIR/work_precision.csv and DIR/work_precision.{svg,png}.
+    WorkPrecision {
+        /// Output directory.
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -62,6 +71,7 @@ fn main() -> ExitCode {
             every,
         } => simulate::run(scenario.as_deref(), model.as_deref(), &out, every),
         Command::Report { out, scenario } => report::run(scenario.as_deref(), &out),
+        Command::WorkPrecision { out } => work_precision::run_study(&out),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

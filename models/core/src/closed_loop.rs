@@ -116,6 +116,17 @@ impl<M: CableModel> ClosedLoop<M> {
         }
     }
 
+    /// Rates of the states after the model's, (w', f', W', D'), at state `y` under `cmd`.
+    fn controller_and_audit_rates(&self, y: &[f64], cmd: &Command, out: &mut [f64]) {
+        let (model_state, pid_state) = self.split(y);
+        let pid_rate = self.pid.state_rate(cmd.error, pid_state);
+        let reel = self.model.reel_speeds(model_state);
+        out[0] = pid_rate.integral;
+        out[1] = pid_rate.filter;
+        out[2] = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
+        out[3] = self.model.dissipation(model_state);
+    }
+
     /// Initial state by the rule of MODELS.md §2: the model's static equilibrium with the effector
     /// at x_ref(0) and F0 unknown, velocities zero, w(0) = F0/I, f(0) = e(0) = 0, audits zero.
     /// Without integral action (I = 0) no controller state holds F0; w(0) = 0 then.
@@ -137,15 +148,9 @@ impl<M: CableModel> OdeSystem for ClosedLoop<M> {
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
         let n = self.model_len();
         let cmd = self.command(t, y);
-        let (model_state, pid_state) = self.split(y);
-        let (model_rate, tail_rate) = dy.split_at_mut(n);
-        self.model.rhs(t, model_state, cmd.tensions, model_rate);
-        let pid_rate = self.pid.state_rate(cmd.error, pid_state);
-        let reel = self.model.reel_speeds(model_state);
-        tail_rate[0] = pid_rate.integral;
-        tail_rate[1] = pid_rate.filter;
-        tail_rate[2] = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
-        tail_rate[3] = self.model.dissipation(model_state);
+        let (model_rate, tail) = dy.split_at_mut(n);
+        self.model.rhs(t, &y[..n], cmd.tensions, model_rate);
+        self.controller_and_audit_rates(y, &cmd, tail);
     }
 }
 
@@ -234,6 +239,11 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
             values[model_entries..].fill(0.0);
         }
         evals
+    }
+
+    fn tail_rate(&mut self, t: f64, y: &[f64], out: &mut [f64]) {
+        let cmd = self.command(t, y);
+        self.controller_and_audit_rates(y, &cmd, out);
     }
 
     fn end_step(&mut self, t: f64, y: &mut [f64]) {
@@ -466,6 +476,7 @@ fn integrate_and_sample<M: CableModel>(
         next: 0,
         samples,
         period: opts.sample_period,
+        t_final: opts.t_final,
     };
     let mut events = Vec::new();
     let mut dopri;
@@ -677,6 +688,8 @@ struct Sampler {
     next: usize,
     samples: usize,
     period: f64,
+    /// End of the run [s]: the last sample is taken there, when the integration reaches it.
+    t_final: f64,
 }
 
 impl Sampler {
@@ -690,9 +703,10 @@ impl Sampler {
         let n = sys.model_len();
         while self.next < self.samples {
             let tk = self.next as f64 * self.period;
-            // The last sample is the end point itself (t_final may not be a multiple of Δt by ulps).
+            // The last sample is the end point itself (t_final may not be a multiple of Δt by ulps),
+            // taken once the integration has reached it.
             let tk = if self.next + 1 == self.samples {
-                tk.min(t)
+                self.t_final
             } else {
                 tk
             };

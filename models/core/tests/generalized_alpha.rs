@@ -55,6 +55,9 @@ impl SecondOrderSystem for Oscillator {
     fn end_step(&mut self, _t: f64, y: &mut [f64]) {
         y[2] = self.start.1 + 0.5 * self.h * (self.start.0 + y[0]);
     }
+    fn tail_rate(&mut self, _t: f64, y: &[f64], out: &mut [f64]) {
+        out[0] = y[0];
+    }
 }
 
 /// Kepler's problem q'' = −q/|q|³ written as R = q'' + q/|q|³, circular orbit q = (cos t, sin t).
@@ -106,6 +109,7 @@ impl SecondOrderSystem for Kepler {
         0
     }
     fn end_step(&mut self, _t: f64, _y: &mut [f64]) {}
+    fn tail_rate(&mut self, _t: f64, _y: &[f64], _out: &mut [f64]) {}
 }
 
 fn run<S: SecondOrderSystem>(

@@ -1,0 +1,184 @@
+//! `cargo xtask work-precision`: error of the effector trajectory against a tight-tolerance
+//! reference versus cost, for DOPRI5 (rtol sweep) and generalised-α (step sweep) on both
+//! massive-cable models → `work_precision.csv` and the figure `work_precision.{svg,png}`.
+//!
+//! The horizon is the transition and 50 ms of settling, [0, 0.25] s: it contains every pulley
+//! event of the transition, and ends before the lumped model's first "hovering" node (≈ 0.29 s),
+//! whose event time is ill-conditioned (a µm of cable vibration moves it by milliseconds, see
+//! verify/tests/implicit.rs), so that beyond it no integrator converges to one reference.
+//! Error: max over the 1e-4 s sample grid of |(x, z) − (x, z)_ref| [m]. Cost: right-hand-side
+//! (residual) evaluations, the honest measure, and wall time (minimum of two runs, so a
+//! scheduler hiccup does not count).
+
+use crate::figures::{self, Figure, Line, Panel};
+use crate::output::write_atomic;
+use anyhow::{Context, Result};
+use cdpr_core::closed_loop::Run;
+use cdpr_core::scenario::{IntegratorKind, ModelKind, Scenario};
+use std::path::Path;
+
+/// Simulated horizon [s] and sample period [s] of the study.
+const HORIZON: f64 = 0.25;
+const SAMPLE_PERIOD: f64 = 1e-4;
+/// DOPRI5 relative tolerances (atol = 1e-4·rtol) and generalised-α steps [s] (ρ∞ = 0.9).
+const RTOLS: [f64; 5] = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8];
+const STEPS: [f64; 6] = [4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5, 1.25e-5];
+/// The reference: DOPRI5 at rtol 1e-10, atol 1e-14.
+const REFERENCE_RTOL: f64 = 1e-10;
+
+/// One point of the study.
+struct Point {
+    model: ModelKind,
+    integrator: &'static str,
+    /// rtol (DOPRI5) or step [s] (implicit).
+    parameter: f64,
+    error: f64,
+    wall_s: f64,
+    rhs_evals: u64,
+    steps: u64,
+    newton_iterations: u64,
+    factorisations: u64,
+}
+
+fn scenario(model: ModelKind, integrator: IntegratorKind, parameter: f64) -> Result<Scenario> {
+    let mut s = Scenario::paper();
+    s.model.kind = model;
+    s.simulation.t_final = HORIZON;
+    s.simulation.sample_period = SAMPLE_PERIOD;
+    s.simulation.integrator = integrator;
+    match integrator {
+        IntegratorKind::Dopri5 => {
+            s.simulation.rtol = parameter;
+            s.simulation.atol = 1e-4 * parameter;
+        }
+        IntegratorKind::Implicit => s.simulation.step = parameter,
+    }
+    s.validate()?;
+    Ok(s)
+}
+
+/// The run, the faster of two (identical: runs are deterministic) for the wall time.
+fn run(s: &Scenario) -> Result<Run> {
+    let first = cdpr_verify::simulate(s, &mut |_| {})?;
+    let second = cdpr_verify::simulate(s, &mut |_| {})?;
+    Ok(if second.wall_s < first.wall_s {
+        second
+    } else {
+        first
+    })
+}
+
+fn error(run: &Run, reference: &Run) -> Result<f64> {
+    let col = |r: &Run, c: &str| r.series.column(c).context("missing channel");
+    let (x, z) = (col(run, "x")?, col(run, "z")?);
+    let (xr, zr) = (col(reference, "x")?, col(reference, "z")?);
+    Ok((0..x.len().min(xr.len()))
+        .map(|i| (x[i] - xr[i]).hypot(z[i] - zr[i]))
+        .fold(0.0, f64::max))
+}
+
+pub fn run_study(out: &Path) -> Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let mut points = Vec::new();
+    for model in [ModelKind::Lumped, ModelKind::Fe] {
+        eprintln!("{model}: reference (DOPRI5, rtol {REFERENCE_RTOL:e})");
+        let mut reference_scenario = scenario(model, IntegratorKind::Dopri5, REFERENCE_RTOL)?;
+        reference_scenario.simulation.atol = 1e-14;
+        let reference = cdpr_verify::simulate(&reference_scenario, &mut |_| {})?;
+        let sweeps = RTOLS
+            .iter()
+            .map(|&p| (IntegratorKind::Dopri5, p))
+            .chain(STEPS.iter().map(|&p| (IntegratorKind::Implicit, p)));
+        for (integrator, parameter) in sweeps {
+            let r = run(&scenario(model, integrator, parameter)?)?;
+            let point = Point {
+                model,
+                integrator: match integrator {
+                    IntegratorKind::Dopri5 => "dopri5",
+                    IntegratorKind::Implicit => "implicit",
+                },
+                parameter,
+                error: error(&r, &reference)?,
+                wall_s: r.wall_s,
+                rhs_evals: r.stats.rhs_evals,
+                steps: r.stats.steps_accepted,
+                newton_iterations: r.stats.newton_iterations,
+                factorisations: r.stats.factorisations,
+            };
+            eprintln!(
+                "{model} {} {parameter:e}: error {:.3e} m, {:.4} s, {} RHS",
+                point.integrator, point.error, point.wall_s, point.rhs_evals
+            );
+            points.push(point);
+        }
+    }
+    write_atomic(&out.join("work_precision.csv"), |w| {
+        writeln!(
+            w,
+            "model,integrator,parameter,error_m,wall_s,rhs_evals,steps,newton_iterations,factorisations"
+        )?;
+        for p in &points {
+            writeln!(
+                w,
+                "{},{},{},{},{},{},{},{},{}",
+                p.model,
+                p.integrator,
+                p.parameter,
+                p.error,
+                p.wall_s,
+                p.rhs_evals,
+                p.steps,
+                p.newton_iterations,
+                p.factorisations
+            )?;
+        }
+        Ok(())
+    })?;
+    let panel = |cost: &str, f: fn(&Point) -> f64| Panel {
+        x_label: cost.into(),
+        y_label: "max |effector − reference| over [0, 0.25] s [m]".into(),
+        log_x: true,
+        log_y: true,
+        lines: [ModelKind::Lumped, ModelKind::Fe]
+            .into_iter()
+            .flat_map(|model| {
+                let points = &points;
+                ["dopri5", "implicit"]
+                    .into_iter()
+                    .map(move |integrator| Line {
+                        label: format!(
+                            "{model}, {}",
+                            if integrator == "dopri5" {
+                                "DOPRI5 (rtol 1e-4 … 1e-8)"
+                            } else {
+                                "generalised-α ρ∞ = 0.9 (h 4e-4 … 1.25e-5 s)"
+                            }
+                        ),
+                        color: figures::model_color(model.name()),
+                        dashed: integrator == "implicit",
+                        points: points
+                            .iter()
+                            .filter(|p| p.model == model && p.integrator == integrator)
+                            .map(|p| (f(p), p.error.max(1e-16)))
+                            .collect(),
+                    })
+            })
+            .collect(),
+        markers: Vec::new(),
+    };
+    figures::render(
+        &Figure {
+            name: "work_precision".into(),
+            title:
+                "Work–precision: effector trajectory error vs cost (paper scenario, [0, 0.25] s)"
+                    .into(),
+            panels: vec![
+                panel("wall time [s]", |p| p.wall_s),
+                panel("right-hand-side evaluations", |p| p.rhs_evals as f64),
+            ],
+        },
+        out,
+    )?;
+    eprintln!("→ {}", out.join("work_precision.csv").display());
+    Ok(())
+}
