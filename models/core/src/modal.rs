@@ -100,12 +100,14 @@ pub fn mode_shapes(jac: &Mat<f64>) -> Result<Vec<ModeShape>, ModalError> {
     if (0..n).any(|i| (0..jac.ncols()).any(|j| !jac[(i, j)].is_finite())) {
         return Err(ModalError::NotFinite);
     }
-    let evd = jac.eigen().map_err(ModalError::Evd)?;
+    let (balanced, d) = balance(jac);
+    let evd = balanced.eigen().map_err(ModalError::Evd)?;
     let (u, s) = (evd.U(), evd.S());
     let mut shapes: Vec<ModeShape> = (0..n)
         .filter(|&k| s[k].im >= 0.0)
         .map(|k| {
-            let col: Vec<c64> = (0..n).map(|i| u[(i, k)]).collect();
+            // Eigenvector of jac = D · eigenvector of D⁻¹ jac D.
+            let col: Vec<c64> = (0..n).map(|i| u[(i, k)] * d[i]).collect();
             let norm = col
                 .iter()
                 .map(|c| c.re * c.re + c.im * c.im)
@@ -143,9 +145,62 @@ pub fn mode_shapes(jac: &Mat<f64>) -> Result<Vec<ModeShape>, ModalError> {
     Ok(shapes)
 }
 
+/// Diagonal similarity balancing (Parlett & Reinsch 1969, LAPACK's `dgebal` without
+/// permutations): B = D⁻¹ A D with D a diagonal of powers of 2 (exact in floating point) so that
+/// each row and column of B have comparable norms. Returns (B, diag D).
+///
+/// Why: a cable Jacobian mixes entries of 1 (q' = v) with k0/m ≈ 2e10 1/s² (v' = −K q/m); faer's
+/// unbalanced Hessenberg QR was observed not to terminate on such a matrix (the damped lumped loop
+/// at C ≈ 6.26e-3 N s), and balancing also reduces the eigenvalue error ~ε‖A‖ to ~ε‖B‖.
+pub fn balance(a: &Mat<f64>) -> (Mat<f64>, Vec<f64>) {
+    let n = a.nrows();
+    let mut b = a.clone();
+    let mut d = vec![1.0; n];
+    for _sweep in 0..100 {
+        let mut changed = false;
+        for i in 0..n {
+            let (mut c, mut r) = (0.0f64, 0.0f64);
+            for j in 0..n {
+                if j != i {
+                    c += b[(j, i)].abs();
+                    r += b[(i, j)].abs();
+                }
+            }
+            if c == 0.0 || r == 0.0 {
+                continue;
+            }
+            let mut f = 1.0;
+            let s = c + r;
+            while c < r / 4.0 {
+                c *= 2.0;
+                r /= 2.0;
+                f *= 2.0;
+            }
+            while c >= r * 4.0 {
+                c /= 2.0;
+                r *= 2.0;
+                f /= 2.0;
+            }
+            if c + r < 0.95 * s {
+                changed = true;
+                d[i] *= f;
+                for j in 0..n {
+                    b[(i, j)] /= f;
+                    b[(j, i)] *= f;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    (b, d)
+}
+
 /// Eigenvalues of `jac` with ω ≥ 0 (one of each conjugate pair), sorted by frequency.
 pub fn modes(jac: &Mat<f64>) -> Result<Vec<Mode>, EvdError> {
-    let mut modes: Vec<Mode> = jac
+    let mut modes: Vec<Mode> = balance(jac)
+        .0
         .eigenvalues()?
         .into_iter()
         .filter(|l| l.im >= 0.0)
