@@ -1,11 +1,13 @@
 //! `cargo xtask`: the cdpr-bench command line.
 //!
 //! - `simulate`: one scenario → `timeseries.csv` and `metrics.json`;
-//! - `report`: the paper scenario for every available model → `REPORT.md` and `metrics.json`.
+//! - `report`: the paper scenario for every available model → `REPORT.md` and `metrics.json`;
+//! - `modes`: closed- and open-loop modes of every model and the axial-damping sweep (issue 7).
 //!
 //! Errors are printed for a person and give a non-zero exit; a failed run keeps its output.
 
 mod figures;
+mod modes;
 mod output;
 mod report;
 mod simulate;
@@ -50,6 +52,19 @@ enum Command {
         #[arg(long)]
         scenario: Option<PathBuf>,
     },
+    /// Closed- and open-loop modes of the three models (CSV, Markdown, spectrum figure) and the
+    /// smallest axial damping that makes every mode decay.
+    Modes {
+        /// Scenario file (TOML, MODELS.md §9); absent = the paper's scenario.
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// Effector position x [m]; absent = the trajectory's x1 and x2.
+        #[arg(long)]
+        at: Option<f64>,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -62,6 +77,7 @@ fn main() -> ExitCode {
             every,
         } => simulate::run(scenario.as_deref(), model.as_deref(), &out, every),
         Command::Report { out, scenario } => report::run(scenario.as_deref(), &out),
+        Command::Modes { scenario, at, out } => modes::run(scenario.as_deref(), at, &out),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
