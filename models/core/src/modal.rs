@@ -31,38 +31,47 @@ impl Mode {
 }
 
 /// Jacobian ∂y'/∂y of the closed loop (model and PID states; the audit states are left out) at
-/// (t, y) by central differences. Step h_j = ε^(1/3)·max(|y_j|, 1e-3): truncation O(h²) and
-/// round-off O(ε/h) balance near 1e-10 relative for the smooth right-hand sides here.
+/// (t, y) by central differences ([`jacobian`] for the step rule).
 pub fn closed_loop_jacobian<M: CableModel>(sys: &mut ClosedLoop<M>, t: f64, y: &[f64]) -> Mat<f64> {
     let n = sys.model_len() + 2;
     jacobian(sys, t, y, n)
 }
 
-/// Jacobian ∂y'_i/∂y_j, i, j < `n`, of any [`OdeSystem`] at (t, y) by central differences (the
-/// components ≥ n, e.g. audit states, are neither perturbed nor returned).
+/// Jacobian ∂y'_i/∂y_j, i, j < `n`, of any [`OdeSystem`] at (t, y) by fourth-order central
+/// differences (five-point stencil; the components ≥ n, e.g. audit states, are neither perturbed
+/// nor returned).
 ///
-/// Step rule h_j = ε^(1/3)·max(|y_j|, 1e-3) (ε the f64 machine epsilon): it balances the O(h²)
-/// truncation against the O(ε/h) round-off for a right-hand side whose scale of variation is the
-/// coordinate's own magnitude (positions ~ 0.1–1 m; velocities 0 at an equilibrium, where 1e-3
-/// m/s sets the floor and the cable models are affine in velocity anyway). For the massive cables the
-/// largest entries are k0/m ≈ 2e10 1/s² with absolute errors below ~1 1/s²; an eigenvalue ±iω of
-/// the second-order structure moves by about δK/(2ω), i.e. < 1e-3 1/s for every oscillatory mode
-/// above 500 rad/s, far below the growth rates of interest (0.5 1/s, MODELS.md §4).
+/// Step rule h_j = ¼ ε^(1/3)·max(|y_j|, 1e-3) ≈ 1.5e-6·max(|y_j|, 1e-3) (ε the f64 machine
+/// epsilon), and the step actually used is (y_j + h_j) − y_j, exact in floating point. Why
+/// fourth order and this step: the soft modes are small differences of stiff terms. The lumped
+/// model's straddling spring can have a free part d ≈ 3e-4 m long (at x = 0.5), with transverse
+/// stiffness T/d ≈ 3e5 N/m, while the open-loop horizontal mode's stiffness is ≈ 1 N/m. Second-
+/// order differences at ε^(1/3)·|y| (6e-6 m at x ≈ 1) err by (h/d)²·T/d ≈ 20 N/m there and turned
+/// that 0.98 rad/s oscillation into a spurious real pair ±1.29 1/s (a nonlinear run shows the
+/// oscillation). Fourth order errs by (h/d)⁴·T/d ≈ 2e-4 N/m, round-off (k0·ulp(1) ≈ 7e-10 N)/h
+/// by ≈ 5e-4 N/m. Checked: h/4 → h/30 changes that mode by 6e-5 relative, the others less. For
+/// the oscillatory modes an entry error δK moves λ = ±iω by about δK/(2ω·m).
 pub fn jacobian<S: OdeSystem>(sys: &mut S, t: f64, y: &[f64], n: usize) -> Mat<f64> {
     let full = sys.dimension();
     let mut yp = y.to_vec();
-    let mut fp = vec![0.0; full];
-    let mut fm = vec![0.0; full];
+    let mut f = [
+        vec![0.0; full],
+        vec![0.0; full],
+        vec![0.0; full],
+        vec![0.0; full],
+    ];
     let mut jac = Mat::<f64>::zeros(n, n);
     for j in 0..n {
-        let h = f64::EPSILON.cbrt() * y[j].abs().max(1e-3);
-        yp[j] = y[j] + h;
-        sys.rhs(t, &yp, &mut fp);
-        yp[j] = y[j] - h;
-        sys.rhs(t, &yp, &mut fm);
+        let h0 = 0.25 * f64::EPSILON.cbrt() * y[j].abs().max(1e-3);
+        // The step actually taken (y + h is rounded).
+        let h = (y[j] + h0) - y[j];
+        for (k, o) in [2.0, 1.0, -1.0, -2.0].into_iter().enumerate() {
+            yp[j] = y[j] + o * h;
+            sys.rhs(t, &yp, &mut f[k]);
+        }
         yp[j] = y[j];
         for i in 0..n {
-            jac[(i, j)] = (fp[i] - fm[i]) / (2.0 * h);
+            jac[(i, j)] = (-f[0][i] + 8.0 * f[1][i] - 8.0 * f[2][i] + f[3][i]) / (12.0 * h);
         }
     }
     jac
