@@ -16,7 +16,7 @@ use std::path::Path;
 
 /// Growth rate [1/s] at or below which a mode counts as decaying in the damping sweep
 /// (justification at [`modes::damping_sweep`]).
-pub const SWEEP_THRESHOLD: f64 = 1e-3;
+pub const SWEEP_THRESHOLD: f64 = 1e-2;
 /// Damping range of the sweep [N s] and its scan points (log-spaced, then bisection).
 const SWEEP_RANGE: (f64, f64) = (1e-5, 1.0);
 const SWEEP_SCAN: usize = 11;
@@ -300,7 +300,8 @@ impl ModesReport {
                 "- {} at x = {}: {at} is the smallest Kelvin–Voigt coefficient for which every \
                  closed-loop mode has σ ≤ {:.0e} 1/s (linearisation resolution {:.1e} 1/s; \
                  {} points in `damping_sweep.csv`). Above it the least stable modes are transverse \
-                 string modes at σ ~ 1e-5–3e-4 1/s, which axial damping does not reach.",
+                 string modes, neutral to within the eigen-solver's scatter on these damped \
+                 Jacobians (|σ| ≲ 2e-3 1/s); axial damping does not reach them.",
                 s.model,
                 s.x,
                 s.threshold,
