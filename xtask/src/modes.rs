@@ -286,7 +286,16 @@ impl ModesReport {
                 )?;
             }
         }
-        writeln!(w, "\n### Axial damping that makes every mode decay\n")?;
+        let mut xs: Vec<f64> = self.analyses.iter().map(|a| a.x).collect();
+        xs.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+        writeln!(w)?;
+        for x in xs {
+            writeln!(
+                w,
+                "![Closed-loop modes at x = {x}: |λ| vs ζ](modes_x{x}.svg)\n\nPNG: [modes_x{x}.png](modes_x{x}.png)\n"
+            )?;
+        }
+        writeln!(w, "### Axial damping that makes every mode decay\n")?;
         for s in &self.sweeps {
             let at = match s.smallest {
                 Some(c) => format!("**C = {c:.4e} N s**"),
