@@ -19,6 +19,7 @@ use cdpr_lumped::Lumped;
 
 pub mod acceptance;
 pub mod irvine;
+pub mod modes;
 
 /// Why a scenario could not be simulated or analysed.
 #[derive(Debug, thiserror::Error)]
@@ -29,6 +30,8 @@ pub enum SimulateError {
     Model(#[from] ModelError),
     #[error("eigenvalue computation failed: {0:?}")]
     Eigen(cdpr_core::modal::EvdError),
+    #[error(transparent)]
+    Modal(#[from] cdpr_core::modal::ModalError),
     #[error("no oscillatory closed-loop mode found")]
     NoMode,
 }

@@ -72,7 +72,7 @@ pub fn model_color(name: &str) -> RGBColor {
     }
 }
 
-fn register_fonts() {
+pub(crate) fn register_fonts() {
     static FONTS: Once = Once::new();
     FONTS.call_once(|| {
         // The font is compiled in; registering it cannot fail for a valid TTF.

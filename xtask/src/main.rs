@@ -2,11 +2,13 @@
 //!
 //! - `simulate`: one scenario → `timeseries.csv` and `metrics.json`;
 //! - `report`: the paper scenario for every available model → `REPORT.md` and `metrics.json`;
-//! - `work-precision`: error vs cost of DOPRI5 and generalised-α on the massive-cable models.
+//! - `work-precision`: error vs cost of DOPRI5 and generalised-α on the massive-cable models;
+//! - `modes`: closed- and open-loop modes of every model and the axial-damping sweep.
 //!
 //! Errors are printed for a person and give a non-zero exit; a failed run keeps its output.
 
 mod figures;
+mod modes;
 mod output;
 mod report;
 mod simulate;
@@ -59,6 +61,19 @@ enum Command {
         #[arg(long, default_value = "reports")]
         out: PathBuf,
     },
+    /// Closed- and open-loop modes of the three models (CSV, Markdown, spectrum figure) and the
+    /// smallest axial damping that makes every mode decay.
+    Modes {
+        /// Scenario file (TOML, MODELS.md §9); absent = the paper's scenario.
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// Effector position x [m]; absent = the trajectory's x1 and x2.
+        #[arg(long)]
+        at: Option<f64>,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -72,6 +87,7 @@ fn main() -> ExitCode {
         } => simulate::run(scenario.as_deref(), model.as_deref(), &out, every),
         Command::Report { out, scenario } => report::run(scenario.as_deref(), &out),
         Command::WorkPrecision { out } => work_precision::run_study(&out),
+        Command::Modes { scenario, at, out } => modes::run(scenario.as_deref(), at, &out),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

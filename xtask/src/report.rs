@@ -104,6 +104,10 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     let checks = acceptance::table(eq15, &views);
 
     let names = write_figures(&base, &outcomes, eq15, out)?;
+    // Issue 7: every model's modes at x1 and x2 and the axial-damping sweep (~1 s).
+    let (x1, x2) = (base.trajectory.x1, base.trajectory.x2);
+    let modes = crate::modes::compute(&base, &[x1, x2], x2)?;
+    modes.write_files(out)?;
     write_json(
         &out.join("metrics.json"),
         &ReportFile {
@@ -120,7 +124,7 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
             checks: &checks,
         },
     )?;
-    write_markdown(&base, &outcomes, &checks, eq15, &names, out)?;
+    write_markdown(&base, &outcomes, &checks, eq15, &names, &modes, out)?;
     let failed = checks.iter().filter(|c| !c.pass).count();
     println!(
         "{} models, {} checks, {} failed → {}",
@@ -373,6 +377,7 @@ fn write_markdown(
     checks: &[Check],
     eq15: f64,
     figures: &[(String, String)],
+    modes: &crate::modes::ModesReport,
     out: &Path,
 ) -> Result<()> {
     let sim = &base.simulation;
@@ -432,6 +437,16 @@ fn write_markdown(
                 m.z_fft_0_5_bin
             )?;
         }
+
+        writeln!(w, "\n## Modes of every model (issue 7)\n")?;
+        let peaks: Vec<(&str, f64, f64)> = outcomes
+            .iter()
+            .map(|o| {
+                let m = &o.metrics;
+                (o.kind.name(), m.z_peak_rad_s, m.z_fft_0_5_bin_rad_s)
+            })
+            .collect();
+        modes.write_section(w, &peaks)?;
 
         writeln!(
             w,

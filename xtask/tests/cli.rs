@@ -114,3 +114,72 @@ fn unknown_models_are_clear_errors() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `modes --at X`: the three models' modes (CSV with every mode, Markdown with the key ones), the
+/// spectrum figure and the damping sweep. The lumped model's growing axial mode (MODELS.md §4)
+/// must be in the CSV with σ > 0.5 1/s, and the sweep must name a damping for both massive models.
+#[test]
+fn modes_writes_tables_figure_and_sweep() {
+    let dir = temp_dir("modes");
+    let out = dir.join("out");
+    let status = xtask()
+        .args(["modes", "--at", "0.6", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("modes.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert!(
+        lines
+            .next()
+            .unwrap()
+            .starts_with("model,loop,x_m,z_m,kind,order,omega_rad_s,growth_1_s")
+    );
+    let growing = lines
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|f| f[0] == "lumped" && f[1] == "closed" && f[4].starts_with("axial"))
+        .filter(|f| f[7].parse::<f64>().unwrap() > 0.5)
+        .count();
+    assert_eq!(growing, 1, "one growing lumped axial mode");
+    let md = std::fs::read_to_string(out.join("modes.md")).unwrap();
+    assert!(md.contains("| lumped | 0.6 | closed | vertical |"), "{md}");
+    for model in ["lumped", "fe"] {
+        assert!(
+            md.contains(&format!("- {model} at x = 0.6: **C = ")),
+            "{md}"
+        );
+    }
+    let sweep = std::fs::read_to_string(out.join("damping_sweep.csv")).unwrap();
+    assert!(sweep.lines().count() > 20);
+    for ext in ["svg", "png"] {
+        assert!(
+            out.join(format!("modes_x0.6.{ext}"))
+                .metadata()
+                .unwrap()
+                .len()
+                > 1000
+        );
+    }
+}
+
+/// An effector position outside the workspace is a clear error and a non-zero exit.
+#[test]
+fn modes_outside_the_workspace_is_an_error() {
+    let dir = temp_dir("modes-bad");
+    let status = xtask()
+        .args(["modes", "--at", "1.5", "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert!(!status.status.success());
+    let stderr = String::from_utf8_lossy(&status.stderr);
+    assert!(
+        stderr.contains("x = 1.5") && stderr.contains("effector x"),
+        "{stderr}"
+    );
+}

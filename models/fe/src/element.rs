@@ -93,9 +93,58 @@ pub fn tension(ea: f64, length: f64, h: f64) -> (f64, f64) {
     (strain, ea * strain.max(0.0))
 }
 
-/// M_e and F_e of MODELS.md FE.5.3 for one element.
+/// M_e and F_e of MODELS.md FE.5.3 for one element (no axial damping).
 #[inline]
 pub fn terms(mat: &Material, k: &MassCoefficients, s: &ElementState) -> ElementTerms {
+    terms_damped(mat, k, s, 0.0)
+}
+
+/// Strain rate ε' = (t·Δ')/h − (1 + ε) h' l'/h of MODELS.md FE.5.7 [1/s]: the chord's stretching
+/// rate minus the relaxation by unstrained length flowing in.
+#[inline]
+pub fn strain_rate(s: &ElementState) -> f64 {
+    let delta = s.rb - s.ra;
+    let len = delta.norm();
+    let strain = len / s.h - 1.0;
+    delta.dot(&(s.vb - s.va)) / (len * s.h) - (1.0 + strain) * s.h_prime * s.l_rate / s.h
+}
+
+/// The Kelvin–Voigt part of the element tension (MODELS.md FE.5.7) for damping C [N s]:
+/// N_d = max(EA ε + C ε', 0) − EA ε while taut, else 0. As in the lumped model (MODELS.md §4) the
+/// total tension is clipped at 0, so a fast-shortening taut element cannot push. Returns (N_d, ε').
+#[inline]
+pub fn damping_tension(mat: &Material, s: &ElementState, damping: f64) -> (f64, f64) {
+    if damping == 0.0 {
+        return (0.0, 0.0);
+    }
+    let strain = (s.rb - s.ra).norm() / s.h - 1.0;
+    if strain <= 0.0 {
+        return (0.0, 0.0);
+    }
+    let rate = strain_rate(s);
+    let elastic = mat.ea * strain;
+    ((elastic + damping * rate).max(0.0) - elastic, rate)
+}
+
+/// Power dissipated by the element's axial damping, D_e = h N_d ε' ≥ 0 [W] (FE.5.7: C h ε'² when
+/// not clipped; with clipping N_d = −EA ε < 0 only while ε' < 0, so still ≥ 0).
+#[inline]
+pub fn dissipation(mat: &Material, s: &ElementState, damping: f64) -> f64 {
+    let (nd, rate) = damping_tension(mat, s, damping);
+    s.h * nd * rate
+}
+
+/// M_e and F_e of MODELS.md FE.5.3 plus the axial damping of FE.5.7 with coefficient C =
+/// `damping` [N s]: the damping tension N_d acts along t like N_e on F_a, F_b, and adds
+/// h' N_d (1 + ε) to F_l (the virtual work −h N_d δε with δε = t·δΔ/h − (1 + ε) h' δl/h; note
+/// (1 + ε), not the (1 + ε/2) of the elastic term, which comes from the strain energy's h).
+#[inline]
+pub fn terms_damped(
+    mat: &Material,
+    k: &MassCoefficients,
+    s: &ElementState,
+    damping: f64,
+) -> ElementTerms {
     let mu = mat.mu;
     let (h, ld) = (s.h, s.l_rate);
     let (a, b) = (s.va, s.vb);
@@ -103,8 +152,9 @@ pub fn terms(mat: &Material, k: &MassCoefficients, s: &ElementState) -> ElementT
     let len2 = delta.norm_squared();
     let len = len2.sqrt();
     let (strain, n) = tension(mat.ea, len, h);
-    // N t with t = Δ/|Δ|: the pull on node a towards b.
-    let pull = delta * (n / len);
+    let (n_damp, _) = damping_tension(mat, s, damping);
+    // (N + N_d) t with t = Δ/|Δ|: the pull on node a towards b.
+    let pull = delta * ((n + n_damp) / len);
     let h_rate = s.h_prime * ld;
     let delta_rate = b - a;
     let inv_h = 1.0 / h;
@@ -128,6 +178,7 @@ pub fn terms(mat: &Material, k: &MassCoefficients, s: &ElementState) -> ElementT
         + s.h_prime
             * (kinetic_density - 0.5 * mu * k.gamma * ld2_len2_h2
                 + n * (1.0 + 0.5 * strain.max(0.0))
+                + n_damp * (1.0 + strain)
                 - mu * mat.gravity * 0.5 * (s.ra.y + s.rb.y));
     ElementTerms {
         m_diag: mu * h * k.c1,

@@ -6,7 +6,7 @@
 //! equation), so colouring the columns of the global matrix would need one residual per column,
 //! O(N²) per matrix. Each element's contribution, though, depends only on its own unknowns
 //! (r_a, r_b, l for a free element; ρ, l for the stored one), so differentiating the element kernel
-//! ([`element::terms`]) in its 5 local unknowns and adding the 5 × 5 blocks gives the exact
+//! ([`element::terms_damped`], the axial damping of FE.5.7 included) in its 5 local unknowns and adding the 5 × 5 blocks gives the exact
 //! global pattern of FE.5.5 (block-tridiagonal with the border rows and columns) at O(N) cost.
 //! Forward differences with δ = √ε·max(|u|, 1e-2) are accurate to ~1e-8 relative, ample for a
 //! Newton matrix; the derivative in q'' is linear and exact.
@@ -101,7 +101,8 @@ impl Fe {
                     h: q[4] / n,
                     h_prime: 1.0 / n,
                 };
-                let t = element::terms(mat, &self.coefficients[e - 1], &s);
+                let t =
+                    element::terms_damped(mat, &self.coefficients[e - 1], &s, self.axial_damping);
                 let (aa, ab) = (Vector2::new(a[0], a[1]), Vector2::new(a[2], a[3]));
                 let ra = aa * t.m_diag + ab * t.m_off + t.m_al * a[4] - t.fa;
                 let rb = aa * t.m_off + ab * t.m_diag + t.m_bl * a[4] - t.fb;
@@ -120,7 +121,8 @@ impl Fe {
                     h: self.modelled_length - q[1],
                     h_prime: -1.0,
                 };
-                let t = element::terms(mat, &self.stored_coefficients, &s);
+                let t =
+                    element::terms_damped(mat, &self.stored_coefficients, &s, self.axial_damping);
                 let m_rho_l = t.m_al.dot(&e_out);
                 r[0] = t.m_diag * a[0] + m_rho_l * a[1] - t.fa.dot(&e_out);
                 r[1] = m_rho_l * a[0] + t.m_ll * a[1] - t.fl;

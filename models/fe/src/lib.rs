@@ -50,6 +50,9 @@ pub struct Fe {
     pub mass: FeMass,
     /// Elastic stored element (reference) or rigid stored cable (FE.1.3).
     pub stored: FeStored,
+    /// Kelvin–Voigt axial damping C [N s] of MODELS.md FE.5.7 (0: undamped, the paper's run). The
+    /// rigid stored cable (FE.1.3) has no strain and so no damping.
+    pub axial_damping: f64,
     /// Mass coefficients of the free elements e = 1…N (index e − 1).
     coefficients: Vec<MassCoefficients>,
     /// Mass coefficients of the stored element (w_R = 0, w_A = 1).
@@ -74,13 +77,11 @@ impl Fe {
             });
         }
         let cable = &scenario.cable;
-        if cable.axial_damping != 0.0 {
+        if !(cable.axial_damping >= 0.0 && cable.axial_damping.is_finite()) {
             return Err(ModelError::Parameter {
                 name: "cable.axial_damping",
                 value: cable.axial_damping,
-                allowed: "0 for the FE model (the Kelvin–Voigt terms of MODELS.md FE.5.7 are not \
-                          implemented)"
-                    .into(),
+                allowed: "finite and ≥ 0 N s (Kelvin–Voigt, MODELS.md FE.5.7)".into(),
             });
         }
         let mass = scenario.model.fe_mass;
@@ -108,6 +109,7 @@ impl Fe {
             },
             mass,
             stored,
+            axial_damping: cable.axial_damping,
             coefficients,
             stored_coefficients: MassCoefficients::new(mass, 0.0, 1.0),
             border_l: l_index,
@@ -238,7 +240,8 @@ impl Fe {
             let col = 2 + 2 * cable;
             for e in 1..=n {
                 let s = self.free_element(y, cable, e);
-                let t = element::terms(&mat, &self.coefficients[e - 1], &s);
+                let t =
+                    element::terms_damped(&mat, &self.coefficients[e - 1], &s, self.axial_damping);
                 let ja = self.chain_index(cable, e - 1);
                 let jb = self.chain_index(cable, e).expect("node e ≥ 1 is free");
                 if let Some(ja) = ja {
@@ -264,7 +267,12 @@ impl Fe {
                 Some(s) => {
                     // Row ρ: the projection of the kernel's R-node terms on e_out (R = A + ρ e_out),
                     // plus the commanded tension pulling R away from the pulley (FE.5.3).
-                    let t = element::terms(&mat, &self.stored_coefficients, &s);
+                    let t = element::terms_damped(
+                        &mat,
+                        &self.stored_coefficients,
+                        &s,
+                        self.axial_damping,
+                    );
                     let e_out = Vector2::new(E_OUT[cable], 0.0);
                     let rb = lb + 1;
                     sys.d[rb][rb] += t.m_diag;
@@ -465,6 +473,26 @@ impl CableModel for Fe {
         e.kinetic += 0.5 * self.effector_mass * v.norm_squared();
         e.gravity += self.effector_mass * mat.gravity * p.y;
         e
+    }
+
+    /// Power of the Kelvin–Voigt damping (FE.5.7), Σ over taut elements (stored one included) of
+    /// h N_d ε' ≥ 0, so that dE/dt = Σ T_i ρ_i' − D and the runner's `e_residual` audits the
+    /// damped model too.
+    fn dissipation(&self, y: &[f64]) -> f64 {
+        if self.axial_damping == 0.0 {
+            return 0.0;
+        }
+        let c = self.axial_damping;
+        let mut d = 0.0;
+        for cable in 0..2 {
+            for e in 1..=self.elements {
+                d += element::dissipation(&self.material, &self.free_element(y, cable, e), c);
+            }
+            if let Some(s) = self.stored_element(y, cable) {
+                d += element::dissipation(&self.material, &s, c);
+            }
+        }
+        d
     }
 
     fn channel_names(&self) -> Vec<String> {

@@ -1,0 +1,455 @@
+//! `cargo xtask modes`: every closed- and open-loop mode of the three models at given effector
+//! positions (issue 7), classified, as CSV and Markdown tables and a figure of the spectrum of modes
+//! (frequency vs damping ratio); and the axial-damping sweep: the smallest Kelvin–Voigt
+//! coefficient C (MODELS.md §4, FE.5.7) that makes every closed-loop mode of the lumped and FE
+//! models decay. The report (`cargo xtask report`) reuses [`ModesReport`] for its modes section.
+
+use crate::figures::model_color;
+use crate::output::write_atomic;
+use anyhow::{Context, Result, anyhow};
+use cdpr_core::Vector2;
+use cdpr_core::scenario::{ModelKind, Scenario};
+use cdpr_verify::modes::{self, Analysis, ClassifiedMode, Loop, ModeKind, Sweep};
+use plotters::prelude::*;
+use std::io::Write;
+use std::path::Path;
+
+/// Growth rate [1/s] at or below which a mode counts as decaying in the damping sweep
+/// (justification at [`modes::damping_sweep`]).
+pub const SWEEP_THRESHOLD: f64 = 1e-2;
+/// Damping range of the sweep [N s] and its scan points (log-spaced, then bisection).
+const SWEEP_RANGE: (f64, f64) = (1e-5, 1.0);
+const SWEEP_SCAN: usize = 11;
+
+/// Everything the modes command computes.
+pub struct ModesReport {
+    pub analyses: Vec<Analysis>,
+    pub sweeps: Vec<Sweep>,
+    /// μ [kg/m] and EA [N] for the taut-string column.
+    pub mu: f64,
+    pub ea: f64,
+    pub anchor_distance: f64,
+    /// Effector mass M [kg] for eq. 15.
+    pub effector_mass: f64,
+}
+
+/// The three models' closed- and open-loop modes at each x, and the damping sweep at `sweep_at`.
+pub fn compute(base: &Scenario, xs: &[f64], sweep_at: f64) -> Result<ModesReport> {
+    let kinds = [ModelKind::Elastic, ModelKind::Lumped, ModelKind::Fe];
+    let mut analyses = Vec::new();
+    for &x in xs {
+        for kind in kinds {
+            let mut s = base.clone();
+            s.model.kind = kind;
+            for feedback in [Loop::Closed, Loop::Open] {
+                analyses.push(
+                    modes::analyse(&s, x, feedback)
+                        .map_err(|e| anyhow!("{kind} model at x = {x}: {e}"))?,
+                );
+            }
+        }
+    }
+    let sweeps = [ModelKind::Lumped, ModelKind::Fe]
+        .into_iter()
+        .map(|kind| {
+            let mut s = base.clone();
+            s.model.kind = kind;
+            modes::damping_sweep(&s, sweep_at, SWEEP_RANGE, SWEEP_SCAN, SWEEP_THRESHOLD)
+                .map_err(|e| anyhow!("{kind} damping sweep: {e}"))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(ModesReport {
+        analyses,
+        sweeps,
+        mu: base.cable.mass_per_length(),
+        ea: base.cable.axial_stiffness(),
+        anchor_distance: base.robot.anchor_distance,
+        effector_mass: base.robot.effector_mass,
+    })
+}
+
+/// `cargo xtask modes`: writes modes.csv, modes.md, damping_sweep.csv and the spectrum figure(s).
+pub fn run(scenario: Option<&Path>, at: Option<f64>, out: &Path) -> Result<()> {
+    let base = crate::simulate::load_scenario(scenario, None)?;
+    let xs = match at {
+        Some(x) => vec![x],
+        None => vec![base.trajectory.x1, base.trajectory.x2],
+    };
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let report = compute(&base, &xs, at.unwrap_or(base.trajectory.x2))?;
+    report.write_files(out)?;
+    write_atomic(&out.join("modes.md"), |w| {
+        writeln!(w, "# Modes of the three models (issue 7)\n")?;
+        report.write_section(w, &[])
+    })?;
+    println!(
+        "{} analyses, {} modes → {}",
+        report.analyses.len(),
+        report.analyses.iter().map(|a| a.modes.len()).sum::<usize>(),
+        out.join("modes.md").display()
+    );
+    Ok(())
+}
+
+fn loop_name(l: Loop) -> &'static str {
+    match l {
+        Loop::Closed => "closed",
+        Loop::Open => "open",
+    }
+}
+
+impl ModesReport {
+    /// The taut-string harmonic ω_k = (kπ/l)√(T/μ_s) of either cable nearest a transverse mode's
+    /// frequency, as (cable, k, ω_k); None for other kinds. Nearest rather than "the mode's own
+    /// cable and rank": at mirror-symmetric positions (x = d/2) the two spans' string modes pair
+    /// into symmetric and antisymmetric combinations (purity 0.5 per cable), so the cable label
+    /// and hence the rank of such a mode are arbitrary.
+    fn taut_string(&self, a: &Analysis, m: &ClassifiedMode) -> Option<(usize, usize, f64)> {
+        if !matches!(m.kind, ModeKind::Transverse(_)) {
+            return None;
+        }
+        let mut best: Option<(usize, usize, f64)> = None;
+        for cable in 0..2 {
+            let pulley = Vector2::new(cable as f64 * self.anchor_distance, 0.0);
+            let chord = (pulley - Vector2::new(a.x, a.z)).norm();
+            let w1 = modes::taut_string(1, chord, a.tensions[cable], self.mu, self.ea);
+            let k = ((m.mode.omega / w1).round() as usize).max(1);
+            let wk = k as f64 * w1;
+            if best.is_none_or(|(_, _, b)| (wk - m.mode.omega).abs() < (b - m.mode.omega).abs()) {
+                best = Some((cable, k, wk));
+            }
+        }
+        best
+    }
+
+    /// modes.csv (every mode), damping_sweep.csv and one figure per position.
+    pub fn write_files(&self, out: &Path) -> Result<()> {
+        write_atomic(&out.join("modes.csv"), |w| {
+            writeln!(
+                w,
+                "model,loop,x_m,z_m,kind,order,omega_rad_s,growth_1_s,damping_ratio,purity,taut_string_rad_s"
+            )?;
+            for a in &self.analyses {
+                for m in &a.modes {
+                    let taut = self
+                        .taut_string(a, m)
+                        .map_or(String::new(), |(_, _, v)| v.to_string());
+                    writeln!(
+                        w,
+                        "{},{},{},{},{},{},{},{},{},{},{}",
+                        a.model,
+                        loop_name(a.feedback),
+                        a.x,
+                        a.z,
+                        m.kind,
+                        m.order,
+                        m.mode.omega,
+                        m.mode.growth,
+                        m.mode.damping_ratio(),
+                        m.purity,
+                        taut
+                    )?;
+                }
+            }
+            Ok(())
+        })?;
+        write_atomic(&out.join("damping_sweep.csv"), |w| {
+            writeln!(
+                w,
+                "model,x_m,axial_damping_N_s,least_stable_kind,least_stable_order,omega_rad_s,growth_1_s,stable"
+            )?;
+            for s in &self.sweeps {
+                for p in &s.points {
+                    let m = &p.least_stable;
+                    writeln!(
+                        w,
+                        "{},{},{},{},{},{},{},{}",
+                        s.model,
+                        s.x,
+                        p.damping,
+                        m.kind,
+                        m.order,
+                        m.mode.omega,
+                        m.mode.growth,
+                        m.mode.growth <= s.threshold
+                    )?;
+                }
+            }
+            Ok(())
+        })?;
+        let mut xs: Vec<f64> = self.analyses.iter().map(|a| a.x).collect();
+        xs.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+        for x in xs {
+            let closed: Vec<&Analysis> = self
+                .analyses
+                .iter()
+                .filter(|a| a.feedback == Loop::Closed && (a.x - x).abs() < 1e-12)
+                .collect();
+            spectrum_figure(&closed, x, out)?;
+        }
+        Ok(())
+    }
+
+    /// The Markdown section: key modes per model, position and loop, the FFT peaks (`peaks`:
+    /// model, refined peak of z over [1, 5] s, plain FFT bin over [0, 5] s, from the report's runs;
+    /// empty for the standalone command), the taut-string formula, the damping sweep.
+    pub fn write_section(
+        &self,
+        w: &mut dyn Write,
+        peaks: &[(&str, f64, f64)],
+    ) -> std::io::Result<()> {
+        writeln!(
+            w,
+            "Every eigenvalue λ = σ + iω of the linearised loop (model + PID + tension distribution, \
+             finite-difference Jacobian, constrained lumped stored-node coordinates removed) at the \
+             static equilibrium at x, classified from its eigenvector by the largest share of \
+             mass-weighted displacement (`purity`). Closed = the paper's PID; open = PID off, \
+             tensions fixed at the equilibrium's. ζ = −σ/|λ|. Taut string: ω_k = (kπ/l)√(T/μ_s) \
+             with the chord l, the commanded tension T and μ_s = μ/(1 + T/EA). All modes: \
+             `modes.csv`; figures: `modes_x*.svg`.\n"
+        )?;
+        if !peaks.is_empty() {
+            writeln!(
+                w,
+                "FFT peaks of the runs (for comparison with the vertical mode at x2): {}.\n",
+                peaks
+                    .iter()
+                    .map(|(m, refined, plain)| format!(
+                        "{m}: refined {refined:.4}, plain 5 s bin {plain:.4} rad/s"
+                    ))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            )?;
+        }
+        writeln!(
+            w,
+            "| model | x [m] | loop | mode | ω [rad/s] | σ [1/s] | ζ | purity | reference [rad/s] |"
+        )?;
+        writeln!(w, "|---|---|---|---|---|---|---|---|---|")?;
+        for a in &self.analyses {
+            let eq15 = cdpr_elastic::eq15_frequency(
+                0.5 * (a.tensions[0] + a.tensions[1]),
+                self.effector_mass,
+                a.x,
+                self.anchor_distance,
+            );
+            let mut rows: Vec<(String, &ClassifiedMode, String)> = Vec::new();
+            if let Some(m) = a.vertical() {
+                rows.push(("vertical".into(), m, format!("eq. 15: {eq15:.4}")));
+            }
+            for m in a.modes.iter().filter(|m| m.kind == ModeKind::Horizontal) {
+                rows.push((m.kind.to_string(), m, String::new()));
+            }
+            let transverse = a
+                .modes
+                .iter()
+                .filter(|m| matches!(m.kind, ModeKind::Transverse(_)));
+            for (rank, m) in transverse.take(2).enumerate() {
+                if let Some((cable, k, t)) = self.taut_string(a, m) {
+                    rows.push((
+                        format!("transverse #{}", rank + 1),
+                        m,
+                        format!("taut string cable {}, k = {k}: {t:.3}", cable + 1),
+                    ));
+                }
+            }
+            for cable in 0..2 {
+                if let Some(m) = a.find(ModeKind::Axial(cable), 1) {
+                    rows.push((
+                        format!("lowest axial, cable {}", cable + 1),
+                        m,
+                        String::new(),
+                    ));
+                }
+            }
+            if let Some(m) = a.least_stable() {
+                rows.push(("**least stable**".into(), m, String::new()));
+            }
+            for (label, m, reference) in rows {
+                let kind = if label.starts_with("**") || label.starts_with("transverse") {
+                    format!("{label} ({})", m.kind)
+                } else {
+                    label
+                };
+                writeln!(
+                    w,
+                    "| {} | {} | {} | {} | {:.4} | {:+.4e} | {:.3e} | {:.3} | {} |",
+                    a.model,
+                    a.x,
+                    loop_name(a.feedback),
+                    kind.replace('|', "\\|"),
+                    m.mode.omega,
+                    m.mode.growth,
+                    m.mode.damping_ratio(),
+                    m.purity,
+                    reference
+                )?;
+            }
+        }
+        let mut xs: Vec<f64> = self.analyses.iter().map(|a| a.x).collect();
+        xs.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+        writeln!(w)?;
+        for x in xs {
+            writeln!(
+                w,
+                "![Closed-loop modes at x = {x}: |λ| vs ζ](modes_x{x}.svg)\n\nPNG: [modes_x{x}.png](modes_x{x}.png)\n"
+            )?;
+        }
+        writeln!(w, "### Axial damping that makes every mode decay\n")?;
+        for s in &self.sweeps {
+            let at = match s.smallest {
+                Some(c) => format!("**C = {c:.4e} N s**"),
+                None => format!(
+                    "none up to {:.0e} N s",
+                    s.points.last().map_or(f64::NAN, |p| p.damping)
+                ),
+            };
+            writeln!(
+                w,
+                "- {} at x = {}: {at} is the smallest Kelvin–Voigt coefficient for which every \
+                 closed-loop mode has σ ≤ {:.0e} 1/s (linearisation resolution {:.1e} 1/s; \
+                 {} points in `damping_sweep.csv`). Above it the least stable modes are transverse \
+                 string modes, neutral to within the eigen-solver's scatter on these damped \
+                 Jacobians (|σ| ≲ 2e-3 1/s); axial damping does not reach them.",
+                s.model,
+                s.x,
+                s.threshold,
+                s.resolution,
+                s.points.len()
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// ζ on a symmetric log axis: sign(ζ)·log10(1 + |ζ|/ZETA0), so that the growing modes
+/// (ζ ≈ −1e-4) and the neutral string modes (|ζ| ~ 1e-9) are visible next to the PID's real
+/// poles (ζ = 1).
+const ZETA0: f64 = 1e-10;
+
+fn symlog(z: f64) -> f64 {
+    z.signum() * (1.0 + z.abs() / ZETA0).log10()
+}
+
+fn symlog_label(v: f64) -> String {
+    let r = v.round();
+    if (v - r).abs() > 1e-6 {
+        return String::new();
+    }
+    if r == 0.0 {
+        "0".into()
+    } else {
+        let e = r.abs() as i32 - 10;
+        format!("{}1e{e}", if r < 0.0 { "−" } else { "" })
+    }
+}
+
+/// Frequency |λ| (log) vs damping ratio ζ (symmetric log) of every closed-loop mode at x, one
+/// colour per model; SVG and 2× PNG like the report's figures.
+fn spectrum_figure(analyses: &[&Analysis], x: f64, out: &Path) -> Result<()> {
+    crate::figures::register_fonts();
+    let name = format!("modes_x{x}");
+    let title = format!("Closed-loop modes at x = {x} m: |λ| vs damping ratio ζ (< 0: growing)");
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (960, 640)).into_drawing_area();
+        draw_spectrum(&root, analyses, &title, 1.0).map_err(|e| anyhow!("drawing {name}: {e}"))?;
+        root.present()
+            .map_err(|e| anyhow!("drawing {name}: {e:?}"))?;
+    }
+    write_atomic(&out.join(format!("{name}.svg")), |w| {
+        w.write_all(svg.as_bytes())
+    })?;
+    let png = out.join(format!("{name}.png"));
+    let tmp = out.join(format!(".{name}.tmp-{}.png", std::process::id()));
+    let drawn = (|| {
+        let root = BitMapBackend::new(&tmp, (1920, 1280)).into_drawing_area();
+        draw_spectrum(&root, analyses, &title, 2.0)?;
+        root.present().map_err(|e| format!("{e:?}"))
+    })();
+    if let Err(e) = drawn {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(anyhow!("drawing {name}: {e}"));
+    }
+    std::fs::rename(&tmp, &png).with_context(|| format!("writing {}", png.display()))
+}
+
+fn draw_spectrum<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    analyses: &[&Analysis],
+    title: &str,
+    scale: f64,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("{e:?}");
+    let px = |v: f64| (v * scale).round() as u32;
+    root.fill(&WHITE).map_err(err)?;
+    let font = ("sans-serif", px(14.0)).into_font();
+    let (y_lo, y_hi) = (symlog(-1e-2), symlog(1.0) + 0.5);
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", px(18.0)).into_font())
+        .margin(px(10.0))
+        .x_label_area_size(px(45.0))
+        .y_label_area_size(px(80.0))
+        .build_cartesian_2d(-1.0f64..6.0, y_lo..y_hi)
+        .map_err(err)?;
+    let x_fmt = |v: &f64| {
+        if (v - v.round()).abs() < 1e-9 {
+            format!("1e{}", v.round() as i64)
+        } else {
+            String::new()
+        }
+    };
+    let y_fmt = |v: &f64| symlog_label(*v);
+    chart
+        .configure_mesh()
+        .x_desc("|λ| [rad/s]")
+        .y_desc("ζ = −σ/|λ| (symmetric log)")
+        .x_labels(8)
+        .y_labels(((y_hi - y_lo).ceil() as usize) + 1)
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
+        .label_style(font.clone())
+        .axis_desc_style(font.clone())
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(LineSeries::new(
+            vec![(-1.0, 0.0), (6.0, 0.0)],
+            RGBColor(110, 110, 110).stroke_width(px(1.0)),
+        ))
+        .map_err(err)?;
+    for a in analyses {
+        let color = model_color(a.model);
+        let points: Vec<(f64, f64)> = a
+            .modes
+            .iter()
+            .map(|m| {
+                let magnitude = m.mode.growth.hypot(m.mode.omega).max(0.1);
+                (magnitude.log10(), symlog(m.mode.damping_ratio()))
+            })
+            .collect();
+        let radius = px(3.0);
+        chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|&p| Circle::new(p, radius, color.stroke_width(px(1.0)))),
+            )
+            .map_err(err)?
+            .label(a.model)
+            .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .label_font(font)
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(160, 160, 160))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
