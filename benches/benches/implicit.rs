@@ -6,8 +6,8 @@
 //!   per step), which isolates the integrator from the 500 001-row output;
 //! - `implicit_cost_vs_n/{lumped,fe}/N`, N = 10 … 1000: 0.02 s of the paper's run from rest
 //!   (200 steps, one sample per step). Criterion's time × 50 is the cost per simulated second.
-//!   The start state is the N = 10 static equilibrium prolonged to N (cable nodes placed along the
-//!   coarse cable at their unstrained arc length): the dense static Newton of the models costs
+//!   The start state is the N = 10 static equilibrium prolonged to N (cable nodes placed on a
+//!   parabola fitted to the coarse free cable, at their unstrained arc length): the dense static Newton of the models costs
 //!   O(n³) and takes minutes at N = 1000, while the prolonged state is within the coarse model's
 //!   discretisation error of equilibrium, which only adds small vibrations. Every N is started the
 //!   same way, so the table measures how a step's cost grows with N.
@@ -67,21 +67,64 @@ fn cdpr_verify_free_model(s: &Scenario) -> Box<dyn CableModel + Send> {
     }
 }
 
-/// Point at unstrained arc length `s` [m] from the start of a polyline whose segment k has
-/// unstrained length `lengths[k]`.
-fn along(points: &[Vector2<f64>], lengths: &[f64], s: f64) -> Vector2<f64> {
-    let mut rest = s;
-    for (k, &l) in lengths.iter().enumerate() {
-        if rest <= l || k + 1 == lengths.len() {
-            let f = (rest / l).clamp(0.0, 1.0);
-            return points[k] + (points[k + 1] - points[k]) * f;
-        }
-        rest -= l;
-    }
-    points[0]
+/// The free span as a smooth curve: the parabola z(ξ) = z_A + ξ (z_P − z_A) + 4 a ξ (1 − ξ) over
+/// the chord's horizontal fraction ξ, its sag a fitted to the coarse nodes by least squares (a
+/// tensioned cable under its weight is a parabola to O(sag²)). Placing the fine nodes on a
+/// smooth curve matters: on the coarse polyline each corner would put a force T·angle on a node of
+/// mass μL0/N, a violent start at large N.
+struct Span {
+    a: Vector2<f64>,
+    p: Vector2<f64>,
+    sag: f64,
+    /// Arc length at ξ = k/RESOLUTION.
+    arc: Vec<f64>,
 }
 
-/// FE: nodes k/N of each span on the coarse span (nodes of a span sit at fixed fractions of its
+const RESOLUTION: usize = 4096;
+
+impl Span {
+    fn fit(nodes: &[Vector2<f64>]) -> Self {
+        let (a, p) = (nodes[0], nodes[nodes.len() - 1]);
+        let (mut num, mut den) = (0.0, 0.0);
+        for q in nodes {
+            let xi = (q.x - a.x) / (p.x - a.x);
+            let phi = 4.0 * xi * (1.0 - xi);
+            num += (q.y - a.y - xi * (p.y - a.y)) * phi;
+            den += phi * phi;
+        }
+        let mut span = Self {
+            a,
+            p,
+            sag: if den > 0.0 { num / den } else { 0.0 },
+            arc: vec![0.0; RESOLUTION + 1],
+        };
+        for k in 1..=RESOLUTION {
+            let (q0, q1) = (
+                span.point((k - 1) as f64 / RESOLUTION as f64),
+                span.point(k as f64 / RESOLUTION as f64),
+            );
+            span.arc[k] = span.arc[k - 1] + (q1 - q0).norm();
+        }
+        span
+    }
+
+    fn point(&self, xi: f64) -> Vector2<f64> {
+        Vector2::new(
+            self.a.x + xi * (self.p.x - self.a.x),
+            self.a.y + xi * (self.p.y - self.a.y) + 4.0 * self.sag * xi * (1.0 - xi),
+        )
+    }
+
+    /// The point at `fraction` of the arc length from the pulley end (uniform strain).
+    fn at(&self, fraction: f64) -> Vector2<f64> {
+        let target = fraction.clamp(0.0, 1.0) * self.arc[RESOLUTION];
+        let k = self.arc.partition_point(|&s| s < target).clamp(1, RESOLUTION);
+        let f = (target - self.arc[k - 1]) / (self.arc[k] - self.arc[k - 1]);
+        self.point((k as f64 - 1.0 + f) / RESOLUTION as f64)
+    }
+}
+
+/// FE: nodes k/N of each span on the fitted span (nodes of a span sit at fixed fractions of its
 /// unstrained length), lengths l_i and ρ_i as in the coarse state.
 fn fe_start(n: i64) -> (Fe, Vec<f64>, f64) {
     let coarse_s = scenario(ModelKind::Fe, Some(10));
@@ -94,13 +137,9 @@ fn fe_start(n: i64) -> (Fe, Vec<f64>, f64) {
         let points: Vec<_> = (0..=nc)
             .map(|k| coarse.node(&eq.state, cable, k).0)
             .collect();
-        let lengths = vec![1.0; nc];
+        let span = Span::fit(&points);
         for k in 1..=fine.elements {
-            let p = along(
-                &points,
-                &lengths,
-                nc as f64 * k as f64 / fine.elements as f64,
-            );
+            let p = span.at(k as f64 / fine.elements as f64);
             let j = fine.chain_index(cable, k).unwrap();
             y[fine.node_coordinate(j, 0)] = p.x;
             y[fine.node_coordinate(j, 1)] = p.y;
@@ -114,7 +153,7 @@ fn fe_start(n: i64) -> (Fe, Vec<f64>, f64) {
 }
 
 /// Lumped: the same free unstrained length per cable as the coarse state; free nodes at their
-/// unstrained distance from the effector along the coarse free cable, stored nodes on z = 0 at
+/// unstrained distance from the effector along the fitted free span, stored nodes on z = 0 at
 /// the strained spacing l0 (1 + T/EA).
 fn lumped_start(n: i64) -> (Lumped, Vec<f64>, f64) {
     let coarse_s = scenario(ModelKind::Lumped, Some(10));
@@ -129,22 +168,18 @@ fn lumped_start(n: i64) -> (Lumped, Vec<f64>, f64) {
     let mut stored = [0; 2];
     for cable in 0..2 {
         let free = coarse.free_length(&eq.state, cable);
-        // From the effector back to the pulley: the coarse free nodes and their unstrained spacing.
+        // The free cable from the pulley to the effector through the coarse free nodes.
         let rc = coarse.stored()[cable];
-        let mut points = vec![effector];
-        let mut lengths = Vec::new();
-        for j in (rc..nc).rev() {
-            points.push(coarse.node(&eq.state, cable, j));
-            lengths.push(coarse.segment);
-        }
-        points.push(coarse.pulley(cable));
-        lengths.push(free - (nc - rc) as f64 * coarse.segment);
+        let mut points = vec![coarse.pulley(cable)];
+        points.extend((rc..nc).map(|j| coarse.node(&eq.state, cable, j)));
+        points.push(effector);
+        let span = Span::fit(&points);
         let l0 = fine.segment;
         let free_springs = (free / l0).floor() as usize;
         let r = nf - free_springs;
         stored[cable] = r;
         for j in r..nf {
-            let p = along(&points, &lengths, (nf - j) as f64 * l0);
+            let p = span.at(1.0 - (nf - j) as f64 * l0 / free);
             y[fine.xi(cable, j)] = p.x;
             y[fine.zi(cable, j)] = p.y;
         }
