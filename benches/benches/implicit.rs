@@ -118,7 +118,10 @@ impl Span {
     /// The point at `fraction` of the arc length from the pulley end (uniform strain).
     fn at(&self, fraction: f64) -> Vector2<f64> {
         let target = fraction.clamp(0.0, 1.0) * self.arc[RESOLUTION];
-        let k = self.arc.partition_point(|&s| s < target).clamp(1, RESOLUTION);
+        let k = self
+            .arc
+            .partition_point(|&s| s < target)
+            .clamp(1, RESOLUTION);
         let f = (target - self.arc[k - 1]) / (self.arc[k] - self.arc[k - 1]);
         self.point((k as f64 - 1.0 + f) / RESOLUTION as f64)
     }
@@ -242,9 +245,18 @@ fn cost_vs_n(c: &mut Criterion) {
         .sample_size(10)
         .measurement_time(Duration::from_secs(10));
     for kind in [ModelKind::Lumped, ModelKind::Fe] {
+        if std::env::var("CDPR_BENCH_ONLY").is_ok_and(|only| only != kind.name()) {
+            continue;
+        }
         for n in [10i64, 30, 100, 300, 1000] {
+            if std::env::var("CDPR_BENCH_N").is_ok_and(|only| only != n.to_string()) {
+                continue;
+            }
             let mut s = scenario(kind, Some(n));
-            s.simulation.t_final = 0.02;
+            s.simulation.t_final = std::env::var("CDPR_BENCH_T")
+                .ok()
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(0.02);
             s.simulation.sample_period = 1e-4;
             match kind {
                 ModelKind::Lumped => {
