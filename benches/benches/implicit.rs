@@ -11,6 +11,10 @@
 //!   O(n³) and takes minutes at N = 1000, while the prolonged state is within the coarse model's
 //!   discretisation error of equilibrium, which only adds small vibrations. Every N is started the
 //!   same way, so the table measures how a step's cost grows with N.
+//!
+//! Knobs for looking into one case (environment): `CDPR_BENCH_ONLY=lumped|fe`, `CDPR_BENCH_N=300`,
+//! `CDPR_BENCH_T=0.002` (simulated time of the cost-vs-N runs [s]) and `CDPR_BENCH_STATS=1`
+//! (print each case's solver counters before timing it).
 
 use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate_from, simulate_reusing};
 use cdpr_core::model::{CableModel, Equilibrium};
