@@ -161,9 +161,11 @@ fn implicit_paper_runs_meet_section_8_and_track_dormand_prince() {
         );
         let s = run.run.stats;
         eprintln!("{}: {s:?}", run.kind);
-        // The step is set by the physics, not by the axial modes: about 5 s / 1e-4 s steps
-        // (a few extra at the lumped model's pulley events), and the matrix is reused.
-        assert!(s.steps_accepted < 52_000, "{s:?}");
+        // The step is set by the physics, not by the axial modes: 5 s / 1e-4 s = 50 000 steps,
+        // plus at most 10 % at reduced size around the lumped model's pulley events (a failed
+        // step is halved and needs four successes per doubling back); the matrix is reused.
+        let nominal = (sim.t_final / sim.step).round() as u64;
+        assert!(s.steps_accepted <= nominal + nominal / 10, "{s:?}");
         assert!(s.factorisations * 20 < s.steps_accepted, "{s:?}");
 
         // The bound: generalised-α's phase error per radian is (ωh)²/12 to leading order

@@ -40,9 +40,12 @@ pub trait SecondOrderForm {
 /// and per derivative (q'', q', q) instead of one per column.
 ///
 /// Steps: R is linear in q'', so δq''_j = max(1, |q''_j|) is exact up to round-off; for q and q'
-/// forward differences with δ_j = √ε·max(|u_j|, u_typ) balance truncation (∝ δ) and round-off
-/// (∝ ε/δ) at about √ε ≈ 1.5e-8 relative, ample for a Newton matrix (it changes the convergence
-/// rate, never the converged answer).
+/// central differences with δ_j = ε^(1/3)·max(|u_j|, u_typ) balance truncation (∝ (δ/ℓ)², ℓ the
+/// shortest length the force varies on) and round-off (∝ ε/δ). Forward differences were not
+/// enough: over the pulley the lumped straddling spring's free part can be ~3e-4 m long, and a
+/// forward step of 1.5e-8·|x| erred by 4e-6 of the matrix there. The matrix only steers Newton
+/// (it changes the convergence rate, never the converged answer), but it is tested against
+/// differences of its own (verify/tests/implicit.rs).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ColouredDifferences {
     n: usize,
@@ -52,6 +55,7 @@ pub struct ColouredDifferences {
     column_entries: Vec<Vec<(usize, usize)>>,
     base: Vec<f64>,
     probe: Vec<f64>,
+    minus: Vec<f64>,
     state: Vec<f64>,
     qdd: Vec<f64>,
     steps: Vec<f64>,
@@ -97,6 +101,7 @@ impl ColouredDifferences {
             column_entries,
             base: vec![0.0; n],
             probe: vec![0.0; n],
+            minus: vec![0.0; n],
             state: vec![0.0; 2 * n],
             qdd: vec![0.0; n],
             steps: vec![0.0; n],
@@ -131,29 +136,42 @@ impl ColouredDifferences {
             if weight == 0.0 {
                 continue;
             }
+            // q'': R is linear, one forward difference is exact. q', q: central differences.
+            let central = derivative != 0;
             for g in 0..self.groups.len() {
-                for &c in &self.groups[g] {
-                    let (slot, typical) = match derivative {
-                        0 => (&mut self.qdd[c], f64::NAN),
-                        1 => (&mut self.state[n + c], TYPICAL_COORDINATE),
-                        _ => (&mut self.state[c], TYPICAL_COORDINATE),
-                    };
-                    let step = if derivative == 0 {
-                        slot.abs().max(1.0)
+                for sign in [1.0, -1.0].into_iter().take(if central { 2 } else { 1 }) {
+                    for &c in &self.groups[g] {
+                        let (slot, original) = match derivative {
+                            0 => (&mut self.qdd[c], qdd[c]),
+                            1 => (&mut self.state[n + c], state[n + c]),
+                            _ => (&mut self.state[c], state[c]),
+                        };
+                        let step = if central {
+                            f64::EPSILON.cbrt() * original.abs().max(TYPICAL_COORDINATE)
+                        } else {
+                            original.abs().max(1.0)
+                        };
+                        *slot = original + sign * step;
+                        // The step actually taken, after rounding (the minus side adds to it).
+                        if sign > 0.0 {
+                            self.steps[c] = *slot - original;
+                        } else {
+                            self.steps[c] += original - *slot;
+                        }
+                    }
+                    let out = if sign > 0.0 {
+                        &mut self.probe
                     } else {
-                        f64::EPSILON.sqrt() * slot.abs().max(typical)
+                        &mut self.minus
                     };
-                    let before = *slot;
-                    *slot += step;
-                    // The step actually taken, after rounding.
-                    self.steps[c] = *slot - before;
+                    residual(&self.state, &self.qdd, out);
+                    evals += 1;
                 }
-                residual(&self.state, &self.qdd, &mut self.probe);
-                evals += 1;
                 for &c in &self.groups[g] {
                     let scale = weight / self.steps[c];
+                    let lower = if central { &self.minus } else { &self.base };
                     for &(r, k) in &self.column_entries[c] {
-                        values[k] += scale * (self.probe[r] - self.base[r]);
+                        values[k] += scale * (self.probe[r] - lower[r]);
                     }
                     match derivative {
                         0 => self.qdd[c] = qdd[c],
@@ -205,7 +223,7 @@ mod tests {
         let mut values = vec![0.0; pattern.len()];
         let mut f = residual;
         let evals = fd.fill(&mut f, &state, &qdd, c_v, c_q, &mut values);
-        assert_eq!(evals, 1 + 3 * 3);
+        assert_eq!(evals, 1 + 3 + 2 * 3 * 2, "q'' forward, q' and q central");
         for (idx, &(i, j)) in pattern.iter().enumerate() {
             let off = (i as isize - j as isize).abs() == 1;
             let deg = (i > 0) as usize + (i + 1 < n) as usize;
@@ -216,9 +234,9 @@ mod tests {
             } else {
                 0.0
             };
-            // Forward differences: relative error ~√ε·(curvature) ≈ 1e-8 of the largest term.
+            // Central differences: relative error ~ε^(2/3) ≈ 4e-11 of the largest term.
             assert!(
-                (values[idx] - exact).abs() <= 1e-7 * exact.abs().max(m),
+                (values[idx] - exact).abs() <= 1e-9 * exact.abs().max(m),
                 "({i}, {j}): {} vs {exact}",
                 values[idx]
             );
