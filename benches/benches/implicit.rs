@@ -48,7 +48,7 @@ fn paper_runs(c: &mut Criterion) {
             let mut buffer = Vec::new();
             group.bench_function(format!("{kind}_paper_run_5s{label}"), |b| {
                 b.iter(|| {
-                    let model = cdpr_verify_free_model(&s);
+                    let model = boxed_model(&s);
                     let mut sys = ClosedLoop::new(model, &s);
                     let run =
                         simulate_reusing(&mut sys, &opts, std::mem::take(&mut buffer), &mut |_| {})
@@ -64,7 +64,7 @@ fn paper_runs(c: &mut Criterion) {
 }
 
 /// The scenario's massive-cable model, boxed (the benches crate does not depend on cdpr-verify).
-fn cdpr_verify_free_model(s: &Scenario) -> Box<dyn CableModel + Send> {
+fn boxed_model(s: &Scenario) -> Box<dyn CableModel + Send> {
     match s.model.kind {
         ModelKind::Lumped => Box::new(Lumped::new(s).unwrap()),
         _ => Box::new(Fe::new(s).unwrap()),

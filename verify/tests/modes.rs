@@ -10,7 +10,7 @@ use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate_from};
 use cdpr_core::integrate::{Dopri5Options, OdeSystem};
 use cdpr_core::modal;
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{IntegratorKind, ModelKind, Scenario};
+use cdpr_core::scenario::{ModelKind, Scenario};
 use cdpr_core::trajectory::Step5;
 use cdpr_elastic::Elastic;
 use cdpr_lumped::Lumped;
@@ -296,17 +296,15 @@ fn lumped_axial_growth_matches_a_nonlinear_run() {
         x2: 0.6,
         ..sys.trajectory
     };
-    let opts = RunOptions {
-        t_final: 1.5,
-        sample_period: 2e-5,
-        integrator: IntegratorKind::Dopri5,
-        dopri: Dopri5Options {
+    let opts = RunOptions::dopri5(
+        1.5,
+        2e-5,
+        Dopri5Options {
             rtol: 1e-5,
             atol: 1e-9,
             ..Dopri5Options::default()
         },
-        implicit: Default::default(),
-    };
+    );
     let run = simulate_from(&mut sys, y0, eq, &opts, &mut |_| {}).unwrap();
     assert!(run.events.is_empty(), "no node passed a pulley");
     let t = run.series.column("t").unwrap();
@@ -394,17 +392,15 @@ fn lumped_open_loop_drift_is_an_oscillation() {
     let tensions = lin.analysis.tensions;
     let mut sys = ClosedLoop::new(model, &s);
     sys.actuation = cdpr_core::closed_loop::Actuation::Prescribed(Box::new(move |_| tensions));
-    let opts = RunOptions {
-        t_final: 2.5,
-        sample_period: 1e-2,
-        integrator: IntegratorKind::Dopri5,
-        dopri: Dopri5Options {
+    let opts = RunOptions::dopri5(
+        2.5,
+        1e-2,
+        Dopri5Options {
             rtol: 1e-9,
             atol: 1e-12,
             ..Dopri5Options::default()
         },
-        implicit: Default::default(),
-    };
+    );
     let run = simulate_from(&mut sys, y0, eq, &opts, &mut |_| {}).unwrap();
     let (sigma, omega) = (m.mode.growth, m.mode.omega);
     let mut worst: f64 = 0.0;

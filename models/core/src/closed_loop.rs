@@ -48,6 +48,8 @@ pub struct ClosedLoop<M: CableModel> {
     pub actuation: Actuation,
     /// The start of the current implicit step (the trapezoidal controller and audit updates).
     step_start: StepStart,
+    /// Two residuals for the tension column of the implicit iteration matrix (allocated once).
+    residual_scratch: [Vec<f64>; 2],
 }
 
 /// What an implicit step needs from its start (t_n, y_n) besides the integrator's own state.
@@ -77,6 +79,7 @@ impl<M: CableModel> ClosedLoop<M> {
             distribution: TensionDistribution::from(&scenario.controller),
             actuation: Actuation::Pid,
             step_start: StepStart::default(),
+            residual_scratch: Default::default(),
         }
     }
 
@@ -101,19 +104,29 @@ impl<M: CableModel> ClosedLoop<M> {
     #[inline]
     pub fn command(&self, t: f64, y: &[f64]) -> Command {
         let (model_state, pid_state) = self.split(y);
+        let x = self.model.effector(model_state).position.x;
+        self.command_at(t, x, |_| pid_state).0
+    }
+
+    /// The command at time t for effector position x [m], with the PID states `pid(e)` for the
+    /// error e (the states themselves, or their implicit-step update), and those states.
+    #[inline]
+    fn command_at(&self, t: f64, x: f64, pid: impl FnOnce(f64) -> PidState) -> (Command, PidState) {
         let reference = self.trajectory.position(t);
-        let error = reference - self.model.effector(model_state).position.x;
+        let error = reference - x;
+        let pid_state = pid(error);
         let force = self.pid.force(error, pid_state);
         let tensions = match &self.actuation {
             Actuation::Pid => self.distribution.tensions(force),
             Actuation::Prescribed(f) => f(t),
         };
-        Command {
+        let command = Command {
             reference,
             error,
             force,
             tensions,
-        }
+        };
+        (command, pid_state)
     }
 
     /// Rates of the states after the model's, (w', f', W', D'), at state `y` under `cmd`.
@@ -191,7 +204,7 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
 
     fn residual(&mut self, t: f64, y: &[f64], qdd: &[f64], r: &mut [f64]) {
         let n = self.model_len();
-        let tensions = self.step_end_command(t, &y[..n]).tensions;
+        let tensions = self.step_end_command(t, &y[..n]).0.tensions;
         if let Some(form) = self.model.second_order_mut() {
             form.residual(&y[..n], qdd, tensions, r);
         }
@@ -207,36 +220,33 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         values: &mut [f64],
     ) -> u64 {
         let n = self.model_len();
-        let tensions = self.step_end_command(t, &y[..n]).tensions;
         // dT/dx of the effector through the trapezoidal PID: T is affine in x (unless saturated),
         // so a unit difference is exact.
-        let Some(x_index) = self.model.second_order().map(|f| f.effector_x()) else {
-            return 0;
-        };
-        let mut shifted = y[..n].to_vec();
-        shifted[x_index] += 1.0;
-        let moved = self.step_end_command(t, &shifted).tensions;
+        let x = self.model.effector(&y[..n]).position.x;
+        let tensions = self.step_end_command_at(t, x).0.tensions;
+        let moved = self.step_end_command_at(t, x + 1.0).0.tensions;
         let slope = [moved[0] - tensions[0], moved[1] - tensions[1]];
+        let [base, probe] = &mut self.residual_scratch;
         let Some(form) = self.model.second_order_mut() else {
             return 0;
         };
-        let model_entries = form.iteration_pattern().len();
-        let mut evals = form.iteration_matrix(&y[..n], qdd, tensions, c_v, c_q, values);
+        // The pattern is the model's, then one entry (row, x) per tension row.
         let rows = form.tension_rows();
+        let (model_values, tension_values) = values.split_at_mut(values.len() - rows.len());
+        let mut evals = form.iteration_matrix(&y[..n], qdd, tensions, c_v, c_q, model_values);
         if slope != [0.0, 0.0] && !rows.is_empty() {
-            // Column x of ∂R/∂T · dT/dx, by one more residual (R is linear in T).
-            let dofs = form.dofs();
-            let mut base = vec![0.0; dofs];
-            let mut probe = vec![0.0; dofs];
-            form.residual(&y[..n], qdd, tensions, &mut base);
+            // Column x of ∂R/∂T · dT/dx, by two more residuals (R is linear in T).
+            base.resize(form.dofs(), 0.0);
+            probe.resize(form.dofs(), 0.0);
+            form.residual(&y[..n], qdd, tensions, base);
             let pulled = [tensions[0] + slope[0], tensions[1] + slope[1]];
-            form.residual(&y[..n], qdd, pulled, &mut probe);
+            form.residual(&y[..n], qdd, pulled, probe);
             evals += 2;
-            for (k, &row) in rows.iter().enumerate() {
-                values[model_entries + k] = c_q * (probe[row] - base[row]);
+            for (value, &row) in tension_values.iter_mut().zip(&rows) {
+                *value = c_q * (probe[row] - base[row]);
             }
         } else {
-            values[model_entries..].fill(0.0);
+            tension_values.fill(0.0);
         }
         evals
     }
@@ -249,11 +259,9 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
     fn end_step(&mut self, t: f64, y: &mut [f64]) {
         let n = self.model_len();
         let s = self.step_start;
-        let error = self.trajectory.position(t) - self.model.effector(&y[..n]).position.x;
-        let pid = self.pid.trapezoidal_step(s.pid, s.error, error, s.h);
+        let (cmd, pid) = self.step_end_command(t, &y[..n]);
         y[n] = pid.integral;
         y[n + 1] = pid.filter;
-        let cmd = self.command(t, y);
         let reel = self.model.reel_speeds(&y[..n]);
         let power = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
         let dissipation = self.model.dissipation(&y[..n]);
@@ -265,22 +273,16 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
 impl<M: CableModel> ClosedLoop<M> {
     /// The command at the end t of the current implicit step for the model state `model_state`:
     /// the PID states advanced by the trapezoidal rule from the step's start.
-    fn step_end_command(&self, t: f64, model_state: &[f64]) -> Command {
+    fn step_end_command(&self, t: f64, model_state: &[f64]) -> (Command, PidState) {
+        self.step_end_command_at(t, self.model.effector(model_state).position.x)
+    }
+
+    /// As [`Self::step_end_command`], for effector position x [m].
+    fn step_end_command_at(&self, t: f64, x: f64) -> (Command, PidState) {
         let s = self.step_start;
-        let reference = self.trajectory.position(t);
-        let error = reference - self.model.effector(model_state).position.x;
-        let pid = self.pid.trapezoidal_step(s.pid, s.error, error, s.h);
-        let force = self.pid.force(error, pid);
-        let tensions = match &self.actuation {
-            Actuation::Pid => self.distribution.tensions(force),
-            Actuation::Prescribed(f) => f(t),
-        };
-        Command {
-            reference,
-            error,
-            force,
-            tensions,
-        }
+        self.command_at(t, x, |error| {
+            self.pid.trapezoidal_step(s.pid, s.error, error, s.h)
+        })
     }
 }
 
@@ -377,6 +379,20 @@ pub struct RunOptions {
     pub integrator: IntegratorKind,
     pub dopri: Dopri5Options,
     pub implicit: GeneralizedAlphaOptions,
+}
+
+impl RunOptions {
+    /// A DOPRI5 run to `t_final` [s], sampled every `sample_period` [s] (tests and studies that
+    /// set the tolerances themselves).
+    pub fn dopri5(t_final: f64, sample_period: f64, dopri: Dopri5Options) -> Self {
+        Self {
+            t_final,
+            sample_period,
+            integrator: IntegratorKind::Dopri5,
+            dopri,
+            implicit: GeneralizedAlphaOptions::default(),
+        }
+    }
 }
 
 impl From<&Scenario> for RunOptions {

@@ -4,7 +4,7 @@
 use cdpr_core::closed_loop::{Actuation, ClosedLoop, RunOptions, simulate_from};
 use cdpr_core::integrate::Dopri5Options;
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{IntegratorKind, Scenario};
+use cdpr_core::scenario::Scenario;
 use cdpr_elastic::{Elastic, eq15_frequency};
 use nalgebra::Vector2;
 use proptest::prelude::*;
@@ -94,13 +94,7 @@ proptest! {
         let mut sys = ClosedLoop::new(m, &scenario);
         sys.actuation = Actuation::Prescribed(Box::new(move |_| tensions));
         let y0 = vec![x + dx, eq.state[1] + dz, vx, vz, 0.0, 0.0, 0.0, 0.0];
-        let opts = RunOptions {
-            t_final: 1.0,
-            sample_period: 1e-3,
-            integrator: IntegratorKind::Dopri5,
-            dopri: Dopri5Options { rtol: 1e-10, atol: 1e-12, ..Dopri5Options::default() },
- implicit: Default::default(),
-};
+        let opts = RunOptions::dopri5(1.0, 1e-3, Dopri5Options { rtol: 1e-10, atol: 1e-12, ..Dopri5Options::default() });
         let run = simulate_from(&mut sys, y0, eq, &opts, &mut |_| {}).unwrap();
         let s = &run.series;
         let col = |n: &str| s.column(n).unwrap();

@@ -5,10 +5,10 @@
 
 mod common;
 
-use cdpr_core::closed_loop::{Actuation, ClosedLoop, RunOptions, simulate_from};
+use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate_from};
 use cdpr_core::integrate::Dopri5Options;
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{FeMass, FeStored, IntegratorKind};
+use cdpr_core::scenario::{FeMass, FeStored};
 use cdpr_fe::Fe;
 use common::*;
 
@@ -39,25 +39,17 @@ fn damped_energy_balance_holds() {
             assert!(d0 >= 0.0, "D = {d0} W must not be negative");
             y.extend_from_slice(&[0.0; 4]);
             let mut sys = ClosedLoop::new(m, &scenario);
-            let pi = std::f64::consts::PI;
-            sys.actuation = Actuation::Prescribed(Box::new(move |t| {
-                [
-                    100.0 + 10.0 * (6.0 * pi * t).sin(),
-                    100.0 + 10.0 * (6.0 * pi * t + 0.5).sin() + 3.0 * (14.0 * pi * t).sin(),
-                ]
-            }));
-            let opts = RunOptions {
-                t_final: 0.3,
-                sample_period: 1e-4,
-                integrator: IntegratorKind::Dopri5,
-                dopri: Dopri5Options {
+            sys.actuation = wobbling_tensions();
+            let opts = RunOptions::dopri5(
+                0.3,
+                1e-4,
+                Dopri5Options {
                     rtol,
                     atol,
                     beta: 0.0,
                     ..Dopri5Options::default()
                 },
-                implicit: Default::default(),
-            };
+            );
             let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
             let residual = run.series.column("e_residual").unwrap();
             let worst = residual.iter().fold(0.0f64, |a, r| a.max(r.abs()));

@@ -4,10 +4,10 @@
 
 mod common;
 
-use cdpr_core::closed_loop::{Actuation, ClosedLoop, RunOptions, simulate_from};
+use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate_from};
 use cdpr_core::integrate::Dopri5Options;
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{FeMass, FeStored, IntegratorKind};
+use cdpr_core::scenario::{FeMass, FeStored};
 use cdpr_core::trajectory::Step5;
 use cdpr_fe::Fe;
 use common::*;
@@ -46,13 +46,7 @@ fn equilibrium_is_preserved() {
     sys.trajectory = Step5::from(&scenario.trajectory);
     let (y0, eq) = sys.initial_state().unwrap();
     let z0 = sys.model.effector(&y0).position.y;
-    let opts = RunOptions {
-        t_final: 0.5,
-        sample_period: 1e-3,
-        integrator: IntegratorKind::Dopri5,
-        dopri: Dopri5Options::default(),
-        implicit: Default::default(),
-    };
+    let opts = RunOptions::dopri5(0.5, 1e-3, Dopri5Options::default());
     let run = simulate_from(&mut sys, y0, eq, &opts, &mut |_| {}).unwrap();
     let x = run.series.column("x").unwrap();
     let z = run.series.column("z").unwrap();
@@ -138,25 +132,17 @@ fn energy_identity_with_prescribed_tensions() {
         let mut y = eq.state.clone();
         y.extend_from_slice(&[0.0; 4]);
         let mut sys = ClosedLoop::new(m, &scenario);
-        let pi = std::f64::consts::PI;
-        sys.actuation = Actuation::Prescribed(Box::new(move |t| {
-            [
-                100.0 + 10.0 * (6.0 * pi * t).sin(),
-                100.0 + 10.0 * (6.0 * pi * t + 0.5).sin() + 3.0 * (14.0 * pi * t).sin(),
-            ]
-        }));
-        let opts = RunOptions {
-            t_final: 0.5,
-            sample_period: 1e-4,
-            integrator: IntegratorKind::Dopri5,
-            dopri: Dopri5Options {
+        sys.actuation = wobbling_tensions();
+        let opts = RunOptions::dopri5(
+            0.5,
+            1e-4,
+            Dopri5Options {
                 rtol,
                 atol,
                 beta: 0.0,
                 ..Dopri5Options::default()
             },
-            implicit: Default::default(),
-        };
+        );
         let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
         let residual = run.series.column("e_residual").unwrap();
         let worst = residual.iter().fold(0.0f64, |a, r| a.max(r.abs()));

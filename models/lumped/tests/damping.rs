@@ -6,7 +6,7 @@
 use cdpr_core::closed_loop::{Actuation, ClosedLoop, RunOptions, simulate_from};
 use cdpr_core::integrate::Dopri5Options;
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{IntegratorKind, ModelKind, Scenario};
+use cdpr_core::scenario::{ModelKind, Scenario};
 use cdpr_lumped::Lumped;
 
 /// From the x = 0.5 equilibrium, the reel end of each cable is kicked (ẋ = ∓0.5 m/s, towards the
@@ -37,18 +37,16 @@ fn damped_energy_balance_holds() {
             100.0 + 10.0 * (6.0 * pi * t + 0.5).sin() + 3.0 * (14.0 * pi * t).sin(),
         ]
     }));
-    let opts = RunOptions {
-        t_final: 0.2,
-        sample_period: 1e-4,
-        integrator: IntegratorKind::Dopri5,
-        dopri: Dopri5Options {
+    let opts = RunOptions::dopri5(
+        0.2,
+        1e-4,
+        Dopri5Options {
             rtol: 1e-8,
             atol: 1e-11,
             beta: 0.0,
             ..Dopri5Options::default()
         },
-        implicit: Default::default(),
-    };
+    );
     let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
     let worst = run
         .series

@@ -5,7 +5,7 @@
 use cdpr_core::closed_loop::{Actuation, ClosedLoop, RunOptions, simulate, simulate_from};
 use cdpr_core::integrate::{Dopri5, Dopri5Options, OdeSystem};
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{IntegratorKind, ModelKind, Scenario};
+use cdpr_core::scenario::{ModelKind, Scenario};
 use cdpr_lumped::{E_OUT, Lumped};
 use proptest::prelude::*;
 
@@ -189,13 +189,7 @@ proptest! {
         y.extend_from_slice(&[0.0; 4]);
         let mut sys = ClosedLoop::new(m, &scenario);
         sys.actuation = Actuation::Prescribed(Box::new(move |_| t));
-        let opts = RunOptions {
-            t_final: 0.4,
-            sample_period: 1e-3,
-            integrator: IntegratorKind::Dopri5,
-            dopri: Dopri5Options { rtol: 1e-9, atol: 1e-12, ..Dopri5Options::default() },
- implicit: Default::default(),
-};
+        let opts = RunOptions::dopri5(0.4, 1e-3, Dopri5Options { rtol: 1e-9, atol: 1e-12, ..Dopri5Options::default() });
         let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
         prop_assert!(run.events.len() >= 4, "the drift moved nodes over the pulleys ({} events)", run.events.len());
         let residual = run.series.column("e_residual").unwrap();

@@ -173,3 +173,15 @@ pub fn applied(m: &Fe, tensions: [f64; 2]) -> Vec<f64> {
     }
     q
 }
+
+/// Commanded tensions that wobble around 100 N at 3 and 7 Hz with a phase offset between the
+/// cables (energy-balance runs: they pump work through both reels and excite the cable).
+pub fn wobbling_tensions() -> cdpr_core::closed_loop::Actuation {
+    let pi = std::f64::consts::PI;
+    cdpr_core::closed_loop::Actuation::Prescribed(Box::new(move |t| {
+        [
+            100.0 + 10.0 * (6.0 * pi * t).sin(),
+            100.0 + 10.0 * (6.0 * pi * t + 0.5).sin() + 3.0 * (14.0 * pi * t).sin(),
+        ]
+    }))
+}
