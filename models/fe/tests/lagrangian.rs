@@ -129,7 +129,7 @@ proptest! {
     /// FE.11.2: the assembled F against central differences of the Lagrangian. Relative to
     /// max |F| (the 100 N tensions) 1e-6, the bound; and the velocity-dependent part alone
     /// (F(q, q') − F(q, 0), 1e-3–1 N) to 1e-5 of its own size, so the small inertial terms are
-    /// tested too (measured: 6e-9 and 1e-7 of the respective sizes).
+    /// tested too (measured: 6e-9 and up to 1e-7 of the respective sizes).
     #[test]
     fn forces_are_the_lagrangian_forces(
         n in prop_oneof![Just(4usize), Just(10)],
@@ -158,7 +158,10 @@ proptest! {
         let dyn_ref: Vec<f64> = (0..np).map(|i| reference[i] - r0[i]).collect();
         let size = max_abs(dyn_model.iter().copied());
         let err = max_abs((0..np).map(|i| dyn_model[i] - dyn_ref[i]));
-        prop_assert!(size > 1e-4, "velocity terms present: {size:e} N");
+        // The reference's round-off is ~1e-10 N (measured 1e-11–3e-10 N), so a draw whose
+        // velocity terms fall below 1e-4 N (random velocities that nearly cancel; about one draw
+        // in fifty, e.g. 8.2e-5 N) cannot show a 1e-5 relative error: proptest draws again.
+        prop_assume!(size > 1e-4, "velocity terms too small to test: {:e} N", size);
         prop_assert!(err <= 1e-5 * size, "velocity part |ΔF| = {err:e} of {size:e}");
     }
 
