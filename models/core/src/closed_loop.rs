@@ -256,6 +256,13 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         self.controller_and_audit_rates(y, &cmd, out);
     }
 
+    fn residual_round_off(&self, y: &[f64]) -> f64 {
+        let n = self.model_len();
+        self.model
+            .second_order()
+            .map_or(0.0, |f| f.residual_round_off(&y[..n]))
+    }
+
     fn end_step(&mut self, t: f64, y: &mut [f64]) {
         let n = self.model_len();
         let s = self.step_start;

@@ -19,6 +19,13 @@ pub trait SecondOrderForm {
     /// The (row, col) entries of ∂R/∂q'', ∂R/∂q' and ∂R/∂q that may be non-zero, for every state
     /// the model can reach (so one symbolic factorisation serves the run).
     fn iteration_pattern(&self) -> Vec<(usize, usize)>;
+    /// Round-off level of max |R| [N] at `state` (0 if negligible). A force k·(q_b − q_a) from
+    /// coordinates of size |q| carries k·ulp(|q|): with k = EA/l0 = 1.8e8 N/m (lumped N = 1000)
+    /// that is above MODELS.md's 1e-7 N Newton tolerance, which the integrator then raises to it.
+    fn residual_round_off(&self, _state: &[f64]) -> f64 {
+        0.0
+    }
+
     /// R = M(q) q'' − F(q, q', T) for state `[q | q']` into `r` (n).
     fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]);
     /// S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q at fixed tensions, in the order of
@@ -35,6 +42,15 @@ pub trait SecondOrderForm {
     ) -> u64;
 }
 
+/// Round-off bound of a spring model's residual [N]: a node's force sums two springs, each
+/// k·(|q_b − q_a| − l0) from two rounded coordinates, so up to 4 k ulp(max |q|). Measured Newton
+/// stalls at N = 1000: 1.0–1.3e-7 N (lumped, bound 2.4e-7 N) and 1.1–1.6e-7 N (FE, bound
+/// 3.2e-7 N); at N ≤ 300 the bound stays below 1e-7 N.
+pub fn spring_round_off(stiffness: f64, positions: &[f64]) -> f64 {
+    let scale = positions.iter().fold(0.0f64, |m, q| m.max(q.abs()));
+    4.0 * stiffness * f64::EPSILON * scale
+}
+
 /// Finite-difference iteration matrix over a sparsity pattern, with the columns grouped so that no
 /// two columns of a group share a row (Curtis, Powell & Reid 1974): one residual evaluation per group
 /// and per derivative (q'', q', q) instead of one per column.
@@ -46,6 +62,16 @@ pub trait SecondOrderForm {
 /// forward step of 1.5e-8·|x| erred by 4e-6 of the matrix there. The matrix only steers Newton
 /// (it changes the convergence rate, never the converged answer), but it is tested against
 /// differences of its own (verify/tests/implicit.rs).
+///
+/// Kinks: a tension-only spring's force has a kink at zero stretch, and a probe that crosses it
+/// sees the slack side: the difference then gives (s + δ)/(2δ) of the stiffness, s the stretch.
+/// On fine meshes s is tiny (lumped N = 1000: l0 · T/EA = 5.6e-7 m against a default step of
+/// 6e-6 m at x = 1 m), and a matrix at half the stiffness made modified Newton contract by only
+/// 0.6–0.8 per iteration at any step size. So the model may state, per coordinate, the largest
+/// step over which its forces stay smooth ([`Self::step_limits_mut`]; e.g. a quarter of the
+/// stretch, so that no probe reaches the kink), and the step is kept below it
+/// ([`central_step`]). Within a smooth region a step that large costs no accuracy: the
+/// truncation error is (δ/ℓ)² with ℓ the geometric length (l0), not the stretch.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ColouredDifferences {
     n: usize,
@@ -59,6 +85,8 @@ pub struct ColouredDifferences {
     state: Vec<f64>,
     qdd: Vec<f64>,
     steps: Vec<f64>,
+    /// Per coordinate, the largest step over which its forces are smooth (∞: no limit).
+    step_limits: Vec<f64>,
 }
 
 /// R(state, q'') into the last argument, at fixed tensions.
@@ -67,6 +95,20 @@ pub type ResidualFn<'a> = dyn FnMut(&[f64], &[f64], &mut [f64]) + 'a;
 /// Typical magnitude of a coordinate [m] and a velocity [m/s] below which the FD step stops
 /// shrinking (a node at z = 0 still gets a step of ~1e-10 m).
 const TYPICAL_COORDINATE: f64 = 1e-2;
+
+/// ε^(1/3), the relative central-difference step (a constant: `cbrt` is not `const`, and it was
+/// 3 % of the lumped implicit run when evaluated per probe).
+pub const CBRT_EPSILON: f64 = 6.0554544523933395e-6;
+
+/// Central-difference step for a coordinate or velocity `x` whose forces are smooth over
+/// [x − `limit`, x + `limit`] (∞ if nothing limits it): ε^(1/3)·max(|x|, 1e-2), the balance of
+/// truncation and round-off, but at most `limit`, and at least 1e3 ulps of max(|x|, 1) (so
+/// that the step is resolved in floating point).
+pub fn central_step(x: f64, limit: f64) -> f64 {
+    let smooth = CBRT_EPSILON * x.abs().max(TYPICAL_COORDINATE);
+    let floor = 1e3 * f64::EPSILON * x.abs().max(1.0);
+    smooth.min(limit).max(floor)
+}
 
 impl ColouredDifferences {
     /// Groups the columns of the n × n `pattern` greedily (first fit, column order).
@@ -105,7 +147,16 @@ impl ColouredDifferences {
             state: vec![0.0; 2 * n],
             qdd: vec![0.0; n],
             steps: vec![0.0; n],
+            step_limits: vec![f64::INFINITY; n],
         }
+    }
+
+    /// Per coordinate q_j, the largest step [m] over which the forces are smooth in q_j (a
+    /// fraction of the stretch of a tension-only spring it moves, of its distance to a pulley):
+    /// the q steps stay below it (see [`central_step`]). ∞ until the model sets it; it keeps its
+    /// values between calls, so a model updates it before each [`Self::fill`].
+    pub fn step_limits_mut(&mut self) -> &mut [f64] {
+        &mut self.step_limits
     }
 
     /// Number of column groups (residual evaluations per derivative).
@@ -146,8 +197,10 @@ impl ColouredDifferences {
                             1 => (&mut self.state[n + c], state[n + c]),
                             _ => (&mut self.state[c], state[c]),
                         };
-                        let step = if central {
-                            f64::EPSILON.cbrt() * original.abs().max(TYPICAL_COORDINATE)
+                        let step = if derivative == 2 {
+                            central_step(original, self.step_limits[c])
+                        } else if central {
+                            central_step(original, f64::INFINITY)
                         } else {
                             original.abs().max(1.0)
                         };
@@ -188,6 +241,83 @@ impl ColouredDifferences {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A chain of tension-only springs stretched by s = 5.6e-7 m (lumped N = 1000 at 100 N),
+    /// at x ≈ 1 m where the default step would be 6e-6 m: with the step limited to s/4 the
+    /// differences give the analytic stiffness k to 1e-6 (round-off k·ulp/δ ≈ 3e-5 N/m of
+    /// k = 1.8e8 N/m); without the limit the probes reach the slack side and the matrix is off
+    /// by (s + δ)/(2δ) − 1 ≈ −45 % (the failure that stalled Newton at N = 1000).
+    #[test]
+    fn step_limits_keep_the_probes_off_the_tension_kink() {
+        let n = 6;
+        let (k, l0, m) = (1.8e8, 1e-3, 1.4e-5);
+        let stretch = 5.6e-7;
+        let residual = |s: &[f64], a: &[f64], r: &mut [f64]| {
+            let q = &s[..n];
+            for i in 0..n {
+                let tension = |d: f64| k * (d - l0).max(0.0);
+                let mut f = 0.0;
+                if i > 0 {
+                    f -= tension(q[i] - q[i - 1]);
+                }
+                if i + 1 < n {
+                    f += tension(q[i + 1] - q[i]);
+                }
+                r[i] = m * a[i] - f;
+            }
+        };
+        let mut pattern = Vec::new();
+        for i in 0..n {
+            for j in i.saturating_sub(1)..(i + 2).min(n) {
+                pattern.push((i, j));
+            }
+        }
+        let mut state = vec![0.0; 2 * n];
+        for (i, q) in state[..n].iter_mut().enumerate() {
+            *q = 1.0 + i as f64 * (l0 + stretch);
+        }
+        let qdd = vec![0.0; n];
+        let c_q = 2.5e-9;
+        let exact = |i: usize, j: usize| {
+            let deg = (i > 0) as usize + (i + 1 < n) as usize;
+            if i == j {
+                m + c_q * k * deg as f64
+            } else {
+                -c_q * k
+            }
+        };
+        let worst = |fd: &mut ColouredDifferences| {
+            let mut values = vec![0.0; pattern.len()];
+            let mut f = residual;
+            fd.fill(&mut f, &state, &qdd, 0.0, c_q, &mut values);
+            pattern
+                .iter()
+                .zip(&values)
+                .map(|(&(i, j), v)| ((v - exact(i, j)) / exact(i, j)).abs())
+                .fold(0.0, f64::max)
+        };
+        let mut limited = ColouredDifferences::new(n, &pattern);
+        limited.step_limits_mut().fill(0.25 * stretch);
+        let error = worst(&mut limited);
+        assert!(error < 1e-6, "limited steps: relative error {error:e}");
+        let error = worst(&mut ColouredDifferences::new(n, &pattern));
+        assert!(
+            error > 0.3,
+            "unlimited steps should reach the slack side: {error:e}"
+        );
+    }
+
+    /// The step: ε^(1/3) max(|x|, 1e-2) when unlimited, the limit when smaller, never below
+    /// 1e3 ulps of max(|x|, 1).
+    #[test]
+    fn central_step_obeys_its_limit_and_floor() {
+        let cbrt = f64::EPSILON.cbrt();
+        assert_eq!(CBRT_EPSILON, cbrt);
+        assert_eq!(central_step(2.0, f64::INFINITY), cbrt * 2.0);
+        assert_eq!(central_step(0.0, f64::INFINITY), cbrt * 1e-2);
+        assert_eq!(central_step(2.0, 1e-9), 1e-9);
+        assert_eq!(central_step(2.0, 1e-20), 2e3 * f64::EPSILON);
+    }
 
     /// A chain of unit masses with springs k between neighbours and dampers c, plus a nonlinear
     /// cubic term: S from the differences against the hand-derived one.

@@ -13,7 +13,7 @@
 
 use crate::element::{self, ElementState};
 use crate::{E_OUT, Fe};
-use cdpr_core::second_order::SecondOrderForm;
+use cdpr_core::second_order::{SecondOrderForm, central_step, spring_round_off};
 use nalgebra::Vector2;
 
 /// One additive block of R: an element, the rigid stored cable or the effector.
@@ -31,9 +31,6 @@ enum Block {
 
 /// Local unknowns of a block (at most 5) and their global indices (None: a fixed pulley node).
 type LocalDofs = [Option<usize>; 5];
-
-/// Smallest magnitude the finite-difference step is scaled to [m, m/s].
-const TYPICAL: f64 = 1e-2;
 
 impl Fe {
     fn blocks(&self) -> Vec<Block> {
@@ -81,6 +78,22 @@ impl Fe {
                 let p = self.effector_index();
                 ([Some(p), Some(nn + p), None, None, None], 2)
             }
+        }
+    }
+
+    /// Largest finite-difference step over which the block's forces are smooth in its positions
+    /// (see [`cdpr_core::second_order::ColouredDifferences`]): a quarter of the element's
+    /// |stretch| = ||Δ| − h|, so no probe reaches the tension-only kink (at N = 1000 the stretch
+    /// is ~5e-7 m, below the 6e-6 m a step scaled by the coordinate would take). A change δ of l
+    /// moves h by δ/N (δ for the stored element), so the same limit is safe for l.
+    fn block_step_limit(&self, block: Block, q: &[f64; 5]) -> f64 {
+        match block {
+            Block::Free { .. } => {
+                let h = q[4] / self.elements as f64;
+                0.25 * ((q[2] - q[0]).hypot(q[3] - q[1]) - h).abs()
+            }
+            Block::Stored { .. } => 0.25 * (q[0] - (self.modelled_length - q[1])).abs(),
+            Block::Rigid { .. } | Block::Effector => f64::INFINITY,
         }
     }
 
@@ -189,6 +202,14 @@ impl SecondOrderForm for Fe {
         pattern
     }
 
+    /// The stiffest element, EA/h with h = min l_i / N, sets the round-off of the forces.
+    fn residual_round_off(&self, state: &[f64]) -> f64 {
+        let shortest = (0..2)
+            .map(|cable| state[self.l_index(cable)] / self.elements as f64)
+            .fold(f64::INFINITY, f64::min);
+        spring_round_off(self.material.ea / shortest, &state[..self.positions_len()])
+    }
+
     /// M q'' − F on the assembly of FE.5.5 (before its solve): the tridiagonal node blocks, the
     /// l-columns C and the border block D.
     fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]) {
@@ -239,6 +260,7 @@ impl SecondOrderForm for Fe {
             let (dofs, len) = self.block_dofs(block);
             let [q, v, a] = self.gather(block, &dofs, state, qdd);
             let base = self.block_residual(block, &q, &v, &a);
+            let limit = self.block_step_limit(block, &q);
             // local[row][col] of S.
             let mut local = [[0.0; 5]; 5];
             for col in 0..len {
@@ -254,7 +276,7 @@ impl SecondOrderForm for Fe {
                         let width = u[which][col] - x;
                         (self.block_residual(block, &u[0], &u[1], &u[2]), base, width)
                     } else {
-                        let step = f64::EPSILON.cbrt() * x.abs().max(TYPICAL);
+                        let step = central_step(x, if which == 0 { limit } else { f64::INFINITY });
                         let (mut up, mut down) = ([q, v, a], [q, v, a]);
                         up[which][col] = x + step;
                         down[which][col] = x - step;

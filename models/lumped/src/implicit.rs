@@ -7,7 +7,9 @@
 //! The pattern does not depend on which nodes are stored, so pulley events never change it.
 
 use crate::Lumped;
-use cdpr_core::second_order::{ColouredDifferences, SecondOrderForm};
+use cdpr_core::second_order::{
+    CBRT_EPSILON, ColouredDifferences, SecondOrderForm, spring_round_off,
+};
 
 /// Buffers of the second-order form (allocated once per model).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -35,6 +37,35 @@ impl Lumped {
             r[i] = self.effector_mass * qdd[i] - f[i];
         }
         self.implicit.forces = f;
+    }
+
+    /// Per position coordinate, the largest finite-difference step over which its forces are
+    /// smooth (see [`ColouredDifferences`]): a quarter of the smallest |λ − l0| of the springs at
+    /// its node (no probe reaches the tension-only kink; a probe moves a spring's length by at
+    /// most the step) and, at the straddling spring's two ends, ε^(1/3) of the node's distance d
+    /// to the pulley (the path's direction turns on the scale d: truncation (δ/d)² ≈ 4e-11).
+    fn step_limits(&self, state: &[f64], out: &mut [f64]) {
+        let n = self.elements;
+        out.fill(f64::INFINITY);
+        for cable in 0..2 {
+            let r = self.stored[cable];
+            for j in 0..n {
+                let (length, _, _, _) = self.spring(state, cable, j);
+                let mut limit = 0.25 * (length - self.segment).abs();
+                if j + 1 == r {
+                    let pulley = self.pulley(cable);
+                    for node in [j, j + 1] {
+                        let d = (self.node(state, cable, node) - pulley).norm();
+                        limit = limit.min(CBRT_EPSILON * d);
+                    }
+                }
+                for node in [j, j + 1] {
+                    for i in self.coordinates(cable, node) {
+                        out[i] = out[i].min(limit);
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -84,6 +115,10 @@ impl SecondOrderForm for Lumped {
         self.residual_into(state, qdd, tensions, r);
     }
 
+    fn residual_round_off(&self, state: &[f64]) -> f64 {
+        spring_round_off(self.stiffness, &state[..self.positions_len()])
+    }
+
     fn iteration_matrix(
         &mut self,
         state: &[f64],
@@ -97,6 +132,7 @@ impl SecondOrderForm for Lumped {
             Some(d) => d,
             None => ColouredDifferences::new(self.dofs(), &self.iteration_pattern()),
         };
+        self.step_limits(state, differences.step_limits_mut());
         let evals = differences.fill(
             &mut |s, a, r| self.residual_into(s, a, tensions, r),
             state,
