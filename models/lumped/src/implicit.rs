@@ -50,7 +50,7 @@ impl Lumped {
         for cable in 0..2 {
             let r = self.stored[cable];
             for j in 0..n {
-                let (length, _, _, _) = self.spring(state, cable, j);
+                let length = self.spring_length(state, cable, j);
                 let mut limit = 0.25 * (length - self.segment).abs();
                 if j + 1 == r {
                     let pulley = self.pulley(cable);

@@ -161,15 +161,6 @@ impl Lumped {
         }
     }
 
-    /// Mass of node `j` (the effector at j = N) [kg].
-    fn mass(&self, j: usize) -> f64 {
-        if j == self.elements {
-            self.effector_mass
-        } else {
-            self.node_mass
-        }
-    }
-
     /// Position of node `j` of `cable` (the effector at j = N) [m].
     pub fn node(&self, y: &[f64], cable: usize, j: usize) -> Vector2<f64> {
         Vector2::new(y[self.xi(cable, j)], y[self.zi(cable, j)])
@@ -184,6 +175,20 @@ impl Lumped {
     #[inline]
     fn spring_tension(&self, length: f64, rate: f64) -> f64 {
         spring_tension(self.stiffness, self.segment, self.damping, length, rate)
+    }
+
+    /// Length λ_j of spring j of `cable` along the cable path (eq. 4 for the straddling spring):
+    /// [`Self::spring`] without the rate and directions, for the energy and the output channels
+    /// (per sample, where the full version was a third of the lumped implicit run).
+    #[inline]
+    pub fn spring_length(&self, y: &[f64], cable: usize, j: usize) -> f64 {
+        let (a, b) = (self.node(y, cable, j), self.node(y, cable, j + 1));
+        if j + 1 == self.stored[cable] {
+            let pulley = self.pulley(cable);
+            (pulley - a).norm() + (pulley - b).norm()
+        } else {
+            (b - a).norm()
+        }
     }
 
     /// Length λ_j of spring j of `cable` along the cable path, its rate λ̇_j, and the unit vectors
@@ -300,7 +305,7 @@ impl Lumped {
         if r == 0 {
             return free_springs;
         }
-        let (length, _, _, _) = self.spring(y, cable, r - 1);
+        let length = self.spring_length(y, cable, r - 1);
         let free_part = (self.pulley(cable) - self.node(y, cable, r)).norm();
         free_springs + self.segment * free_part / length
     }
@@ -357,24 +362,39 @@ impl CableModel for Lumped {
     }
 
     fn energy(&self, y: &[f64]) -> Energy {
+        // One sweep over each cable's contiguous coordinate slices (this runs per output sample),
+        // then the springs whose path is not the straight chord: the straddling one (eq. 4) and
+        // the one to the effector.
+        let n = self.elements;
+        let np = self.positions_len();
+        let (m, g, l0, k) = (self.node_mass, self.gravity, self.segment, self.stiffness);
+        let elastic = |length: f64| {
+            let stretch = (length - l0).max(0.0);
+            0.5 * k * stretch * stretch
+        };
         let mut e = Energy::default();
-        for j in 0..=self.elements {
-            for cable in 0..2 {
-                if j == self.elements && cable == 1 {
-                    break; // the effector is shared
-                }
-                let m = self.mass(j);
-                e.kinetic += 0.5 * m * self.node_velocity(y, cable, j).norm_squared();
-                e.gravity += m * self.gravity * self.node(y, cable, j).y;
-            }
-        }
         for cable in 0..2 {
-            for j in 0..self.elements {
-                let (length, _, _, _) = self.spring(y, cable, j);
-                let stretch = (length - self.segment).max(0.0);
-                e.elastic += 0.5 * self.stiffness * stretch * stretch;
+            let (bx, bz) = (self.xi(cable, 0), self.zi(cable, 0));
+            let (x, z) = (&y[bx..bx + n], &y[bz..bz + n]);
+            let (vx, vz) = (&y[np + bx..np + bx + n], &y[np + bz..np + bz + n]);
+            e.kinetic += 0.5 * m * vx.iter().zip(vz).map(|(a, b)| a * a + b * b).sum::<f64>();
+            // Stored nodes sit at z = 0 exactly, so they add nothing here.
+            e.gravity += m * g * z.iter().sum::<f64>();
+            let straddling = self.stored[cable].checked_sub(1);
+            for j in 0..n - 1 {
+                if Some(j) != straddling {
+                    let (dx, dz) = (x[j + 1] - x[j], z[j + 1] - z[j]);
+                    e.elastic += elastic((dx * dx + dz * dz).sqrt());
+                }
+            }
+            e.elastic += elastic(self.spring_length(y, cable, n - 1));
+            if let Some(j) = straddling.filter(|&j| j != n - 1) {
+                e.elastic += elastic(self.spring_length(y, cable, j));
             }
         }
+        let (p, v) = (self.node(y, 0, n), self.node_velocity(y, 0, n));
+        e.kinetic += 0.5 * self.effector_mass * v.norm_squared();
+        e.gravity += self.effector_mass * g * p.y;
         e
     }
 
