@@ -164,6 +164,40 @@ impl ColouredDifferences {
         self.groups.len()
     }
 
+    /// J = ∂R/∂u of `residual(u, r)` at `u` into `values` (pattern order; duplicate entries get
+    /// 0) by central differences with the absolute steps `steps` (one per column): the static
+    /// Newton's Jacobian. Returns the residual evaluations used (2 per group).
+    pub fn jacobian(
+        &mut self,
+        residual: &mut dyn FnMut(&[f64], &mut [f64]),
+        u: &[f64],
+        steps: &[f64],
+        values: &mut [f64],
+    ) -> u64 {
+        values.fill(0.0);
+        let probe_u = &mut self.qdd;
+        probe_u.copy_from_slice(u);
+        let mut evals = 0;
+        for group in &self.groups {
+            for (sign, out) in [(1.0, &mut self.probe), (-1.0, &mut self.minus)] {
+                for &c in group {
+                    probe_u[c] = u[c] + sign * steps[c];
+                }
+                residual(probe_u, out);
+                evals += 1;
+            }
+            for &c in group {
+                // The step actually taken, after rounding, on both sides.
+                let width = (u[c] + steps[c]) - (u[c] - steps[c]);
+                for &(r, k) in &self.column_entries[c] {
+                    values[k] += (self.probe[r] - self.minus[r]) / width;
+                }
+                probe_u[c] = u[c];
+            }
+        }
+        evals
+    }
+
     /// S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q of `residual(state, qdd, r)` at (state, qdd) into
     /// `values` (pattern order; duplicate entries get 0). Returns the residual evaluations used.
     #[allow(clippy::too_many_arguments)]

@@ -8,6 +8,7 @@
 
 use crate::Fe;
 use cdpr_core::model::{CableModel, Equilibrium, ModelError};
+use cdpr_core::second_order::SecondOrderForm;
 use cdpr_core::statics::{self, NewtonOptions, StaticProblem};
 use nalgebra::Vector2;
 
@@ -57,6 +58,19 @@ impl StaticProblem for Problem<'_> {
             r[nn + j] = s.rhs[j][1];
         }
         r[2 * nn..2 * nn + s.border].copy_from_slice(&s.f_border[..s.border]);
+    }
+    /// The assembly's pattern (`SecondOrderForm::iteration_pattern`: node blocks and the l
+    /// border) over the unknowns (every q but the effector's x, whose row is F0's equation).
+    fn pattern(&self) -> Option<Vec<(usize, usize)>> {
+        let p = self.model.effector_index();
+        let force = self.map.len();
+        Some(statics::pattern_from_dynamics(
+            &self.model.iteration_pattern(),
+            Some,
+            |j| (j != p).then(|| j - usize::from(j > p)),
+            &self.model.tension_rows(),
+            force,
+        ))
     }
     /// 1e-4 m for lengths: a 6e-10 m step, far inside an element's stretch (ε h = 2.8e-5 m at
     /// 100 N, h = 0.05 m; a step beyond it would slacken the element and corrupt the Jacobian)

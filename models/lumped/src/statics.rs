@@ -9,6 +9,7 @@
 
 use crate::{E_OUT, Lumped};
 use cdpr_core::model::{CableModel, Equilibrium, ModelError};
+use cdpr_core::second_order::SecondOrderForm;
 use cdpr_core::statics::{self, NewtonOptions, StaticProblem};
 use nalgebra::Vector2;
 
@@ -77,6 +78,28 @@ impl StaticProblem for Problem {
         }
         // The effector's horizontal balance closes the system for F0.
         r[self.map.len()] = self.forces[4 * self.model.elements];
+    }
+    /// The chain's pattern (`SecondOrderForm::iteration_pattern`) over the unknowns; the
+    /// effector's x row is F0's equation.
+    fn pattern(&self) -> Option<Vec<(usize, usize)>> {
+        let mut unknown = vec![None; self.model.positions_len()];
+        for (k, &i) in self.map.iter().enumerate() {
+            unknown[i] = Some(k);
+        }
+        let (force, effector_x) = (self.map.len(), self.model.xi(0, self.model.elements));
+        Some(statics::pattern_from_dynamics(
+            &self.model.iteration_pattern(),
+            |i| {
+                if i == effector_x {
+                    Some(force)
+                } else {
+                    unknown[i]
+                }
+            },
+            |j| unknown[j],
+            &self.model.tension_rows(),
+            force,
+        ))
     }
     /// Finite-difference scales: 1e-4 m for coordinates, a 6e-10 m step, far inside a spring's
     /// stretch (T/k0 = 8e-6 m at 60 N; a step beyond it slackens the spring and corrupts the
