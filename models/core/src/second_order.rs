@@ -278,8 +278,8 @@ mod tests {
 
     /// A chain of tension-only springs stretched by s = 5.6e-7 m (lumped N = 1000 at 100 N),
     /// at x ≈ 1 m where the default step would be 6e-6 m: with the step limited to s/4 the
-    /// differences give the analytic stiffness k to 1e-6 (round-off k·ulp/δ ≈ 3e-5 N/m of
-    /// k = 1.8e8 N/m); without the limit the probes reach the slack side and the matrix is off
+    /// differences give the analytic stiffness k to 1e-6 (round-off k·ulp(1 m)/δ ≈ 0.3 N/m,
+    /// 2e-9 of k = 1.8e8 N/m); without the limit the probes reach the slack side and the matrix is off
     /// by (s + δ)/(2δ) − 1 ≈ −45 % (the failure that stalled Newton at N = 1000).
     #[test]
     fn step_limits_keep_the_probes_off_the_tension_kink() {

@@ -9,7 +9,9 @@
 //! ([`element::terms_damped`], the axial damping of FE.5.7 included) in its 5 local unknowns and adding the 5 × 5 blocks gives the exact
 //! global pattern of FE.5.5 (block-tridiagonal with the border rows and columns) at O(N) cost.
 //! Central differences with δ = ε^(1/3)·max(|u|, 1e-2) are accurate to ~1e-10 relative (as in
-//! [`cdpr_core::second_order::ColouredDifferences`]); the derivative in q'' is linear and exact.
+//! [`cdpr_core::second_order::ColouredDifferences`]), the position steps kept within a quarter
+//! of the element's stretch ([`cdpr_core::second_order::central_step`]); the derivative in q''
+//! is linear and exact.
 
 use crate::element::{self, ElementState};
 use crate::{E_OUT, Fe};
@@ -84,7 +86,7 @@ impl Fe {
     /// Largest finite-difference step over which the block's forces are smooth in its positions
     /// (see [`cdpr_core::second_order::ColouredDifferences`]): a quarter of the element's
     /// |stretch| = ||Δ| − h|, so no probe reaches the tension-only kink (at N = 1000 the stretch
-    /// is ~5e-7 m, below the 6e-6 m a step scaled by the coordinate would take). A change δ of l
+    /// is 2.8–4.5e-7 m, below the 6e-6 m a step scaled by the coordinate would take). A change δ of l
     /// moves h by δ/N (δ for the stored element), so the same limit is safe for l.
     fn block_step_limit(&self, block: Block, q: &[f64; 5]) -> f64 {
         match block {
@@ -202,7 +204,9 @@ impl SecondOrderForm for Fe {
         pattern
     }
 
-    /// The stiffest element, EA/h with h = min l_i / N, sets the round-off of the forces.
+    /// The stiffest element, EA/h with h = min l_i / N, sets the round-off of the forces (the
+    /// stored element, EA/(L0 − l), would be stiffer only if L0 − l < l/N, outside the paper's
+    /// workspace).
     fn residual_round_off(&self, state: &[f64]) -> f64 {
         let shortest = (0..2)
             .map(|cable| state[self.l_index(cable)] / self.elements as f64)

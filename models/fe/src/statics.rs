@@ -72,6 +72,9 @@ impl StaticProblem for Problem<'_> {
             force,
         ))
     }
+    fn residual_round_off(&self) -> f64 {
+        self.model.residual_round_off(&self.y)
+    }
     /// 1e-4 m for lengths: a 6e-10 m step, far inside an element's stretch (ε h = 2.8e-5 m at
     /// 100 N, h = 0.05 m; a step beyond it would slacken the element and corrupt the Jacobian)
     /// and moving the forces by EA/h·6e-10 ≈ 2e-3 N against a round-off of EA/h·ulp ≈ 4e-10 N.

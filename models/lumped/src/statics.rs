@@ -101,6 +101,9 @@ impl StaticProblem for Problem {
             force,
         ))
     }
+    fn residual_round_off(&self) -> f64 {
+        self.model.residual_round_off(&self.y)
+    }
     /// Finite-difference scales: 1e-4 m for coordinates, a 6e-10 m step, far inside a spring's
     /// stretch (T/k0 = 8e-6 m at 60 N; a step beyond it slackens the spring and corrupts the
     /// Jacobian) and still moving forces by 4e-3 N against a 2e-9 N round-off. ΣT for F0, on
