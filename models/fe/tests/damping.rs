@@ -5,8 +5,6 @@
 
 mod common;
 
-use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate_from};
-use cdpr_core::integrate::Dopri5Options;
 use cdpr_core::model::CableModel;
 use cdpr_core::scenario::{FeMass, FeStored};
 use cdpr_fe::Fe;
@@ -37,22 +35,7 @@ fn damped_energy_balance_holds() {
             }
             let d0 = m.dissipation(&y);
             assert!(d0 >= 0.0, "D = {d0} W must not be negative");
-            y.extend_from_slice(&[0.0; 4]);
-            let mut sys = ClosedLoop::new(m, &scenario);
-            sys.actuation = wobbling_tensions();
-            let opts = RunOptions::dopri5(
-                0.3,
-                1e-4,
-                Dopri5Options {
-                    rtol,
-                    atol,
-                    beta: 0.0,
-                    ..Dopri5Options::default()
-                },
-            );
-            let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
-            let residual = run.series.column("e_residual").unwrap();
-            let worst = residual.iter().fold(0.0f64, |a, r| a.max(r.abs()));
+            let (run, worst) = wobbling_run(m, &scenario, eq, y, 0.3, (rtol, atol));
             let dissipated = *run.series.column("e_dissipated").unwrap().last().unwrap();
             eprintln!(
                 "{mass:?} rtol {rtol:e}: max |E − E0 − W + D| = {worst:e} J, D = {dissipated:e} J, \

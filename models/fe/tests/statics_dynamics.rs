@@ -129,25 +129,9 @@ fn energy_identity_with_prescribed_tensions() {
         let scenario = scenario(10, FeMass::Consistent, FeStored::Elastic);
         let mut m = paper_model();
         let eq = m.equilibrium(0.5, 200.0).unwrap();
-        let mut y = eq.state.clone();
-        y.extend_from_slice(&[0.0; 4]);
-        let mut sys = ClosedLoop::new(m, &scenario);
-        sys.actuation = wobbling_tensions();
-        let opts = RunOptions::dopri5(
-            0.5,
-            1e-4,
-            Dopri5Options {
-                rtol,
-                atol,
-                beta: 0.0,
-                ..Dopri5Options::default()
-            },
-        );
-        let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
-        let residual = run.series.column("e_residual").unwrap();
-        let worst = residual.iter().fold(0.0f64, |a, r| a.max(r.abs()));
-        let work = run.series.column("w_reel").unwrap();
-        let throughput = work.iter().fold(0.0f64, |a, w| a.max(w.abs()));
+        let y = eq.state.clone();
+        let (run, worst) = wobbling_run(m, &scenario, eq, y, 0.5, (rtol, atol));
+        let throughput = column_max_abs(&run, "w_reel");
         eprintln!(
             "rtol {rtol:e}: max |E − E0 − W| = {worst:e} J, max |W| = {throughput:.4} J, {} RHS",
             run.stats.rhs_evals

@@ -176,6 +176,40 @@ pub fn applied(m: &Fe, tensions: [f64; 2]) -> Vec<f64> {
 
 /// Commanded tensions that wobble around 100 N at 3 and 7 Hz with a phase offset between the
 /// cables (energy-balance runs: they pump work through both reels and excite the cable).
+/// DOPRI5 (β = 0, rtol, atol) from the model state `y` (controller and audit states appended as
+/// zeros) under [`wobbling_tensions`], to `t_final` [s] sampled every 1e-4 s, and the largest
+/// |E − E0 − W + D| of the run [J]: the energy identity the FE tests audit.
+pub fn wobbling_run(
+    m: Fe,
+    scenario: &Scenario,
+    eq: cdpr_core::model::Equilibrium,
+    mut y: Vec<f64>,
+    t_final: f64,
+    (rtol, atol): (f64, f64),
+) -> (cdpr_core::closed_loop::Run, f64) {
+    use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate_from};
+    use cdpr_core::integrate::Dopri5Options;
+    y.extend_from_slice(&[0.0; 4]);
+    let mut sys = ClosedLoop::new(m, scenario);
+    sys.actuation = wobbling_tensions();
+    let dopri = Dopri5Options {
+        rtol,
+        atol,
+        beta: 0.0,
+        ..Dopri5Options::default()
+    };
+    let opts = RunOptions::dopri5(t_final, 1e-4, dopri);
+    let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
+    let worst = column_max_abs(&run, "e_residual");
+    (run, worst)
+}
+
+/// Largest |value| of a time-series channel.
+pub fn column_max_abs(run: &cdpr_core::closed_loop::Run, channel: &str) -> f64 {
+    let values = run.series.column(channel).unwrap();
+    values.iter().fold(0.0f64, |a, v| a.max(v.abs()))
+}
+
 pub fn wobbling_tensions() -> cdpr_core::closed_loop::Actuation {
     let pi = std::f64::consts::PI;
     cdpr_core::closed_loop::Actuation::Prescribed(Box::new(move |t| {
