@@ -6,7 +6,6 @@
 
 use cdpr_core::closed_loop::{ClosedLoop, Run, RunFailure, RunOptions, simulate as run_loop};
 use cdpr_core::integrate::AlphaCoefficients;
-use cdpr_core::integrate::OdeSystem;
 use cdpr_core::metrics::Metrics;
 use cdpr_core::modal::{self, Mode};
 use cdpr_core::model::{CableModel, Equilibrium, ModelError};
@@ -144,12 +143,7 @@ fn end_state_of<M: CableModel>(
     mut sys: ClosedLoop<M>,
     scenario: &Scenario,
 ) -> Result<EndState, SimulateError> {
-    let x2 = scenario.trajectory.x2;
-    let eq = sys.model.equilibrium(x2, scenario.controller.tension_sum)?;
-    let pid = sys.pid.state_holding(eq.force).unwrap_or_default();
-    let mut y = eq.state.clone();
-    y.extend_from_slice(&[pid.integral, pid.filter, 0.0, 0.0]);
-    debug_assert_eq!(y.len(), sys.dimension());
+    let (y, eq) = sys.rest_state(scenario.trajectory.x2)?;
     // After t2 the reference is constant: the loop is autonomous there.
     let t = scenario.trajectory.t2 + 1.0;
     let jac = modal::closed_loop_jacobian(&mut sys, t, &y);

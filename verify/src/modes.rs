@@ -176,12 +176,6 @@ impl ModalLayout for Fe {
     }
 }
 
-impl<M: ModalLayout + ?Sized> ModalLayout for Box<M> {
-    fn layout(&self, state: &[f64]) -> Layout {
-        (**self).layout(state)
-    }
-}
-
 /// What a mode is, by the largest share of its mass-weighted displacement.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 pub enum ModeKind {
@@ -256,13 +250,6 @@ impl Analysis {
             .find(|m| m.kind == kind && m.order == order)
     }
 
-    /// The lowest-frequency axial mode of either cable.
-    pub fn lowest_axial(&self) -> Option<&ClassifiedMode> {
-        self.modes
-            .iter()
-            .find(|m| matches!(m.kind, ModeKind::Axial(_)) && m.mode.omega > 0.0)
-    }
-
     /// The oscillatory vertical mode (the lowest of that kind).
     pub fn vertical(&self) -> Option<&ClassifiedMode> {
         self.modes
@@ -310,11 +297,8 @@ pub fn linearise_model<M: CableModel + ModalLayout>(
         x2: x,
         ..sys.trajectory
     };
-    let eq = sys.model.equilibrium(x, sys.distribution.tension_sum)?;
+    let (y, eq) = sys.rest_state(x)?;
     let tensions = sys.distribution.tensions(eq.force);
-    let pid = sys.pid.state_holding(eq.force).unwrap_or_default();
-    let mut y = eq.state.clone();
-    y.extend_from_slice(&[pid.integral, pid.filter, 0.0, 0.0]);
     if feedback == Loop::Open {
         sys.actuation = Actuation::Prescribed(Box::new(move |_| tensions));
     }
@@ -331,7 +315,7 @@ pub fn linearise_model<M: CableModel + ModalLayout>(
         keep.extend([n, n + 1]);
     }
     let jac = modal::jacobian(&mut sys, 0.0, &y, n + 2);
-    let shapes = modal::mode_shapes(&modal::reduce(&jac, &keep)).map_err(SimulateError::Modal)?;
+    let shapes = modal::mode_shapes(&modal::reduce(&jac, &keep))?;
     let mut modes = Vec::with_capacity(shapes.len());
     let mut vectors = Vec::with_capacity(shapes.len());
     for shape in &shapes {
@@ -536,7 +520,7 @@ pub fn damping_sweep(
     };
     points.sort_by(|a, b| a.damping.total_cmp(&b.damping));
     Ok(Sweep {
-        model: crate::model(scenario)?.name(),
+        model: scenario.model.kind.name(),
         x,
         threshold,
         resolution,

@@ -241,7 +241,8 @@ fn tick(v: f64) -> String {
     if s == "-0" { "0".into() } else { s.into() }
 }
 
-fn power_label(v: &f64) -> String {
+/// Tick label of a log10 axis: "1eK" at the integer K, nothing between.
+pub(crate) fn power_label(v: &f64) -> String {
     if (v - v.round()).abs() < 1e-9 {
         format!("1e{}", v.round() as i64)
     } else {

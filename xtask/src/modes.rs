@@ -4,7 +4,7 @@
 //! coefficient C (MODELS.md §4, FE.5.7) that makes every closed-loop mode of the lumped and FE
 //! models decay. The report (`cargo xtask report`) reuses [`ModesReport`] for its modes section.
 
-use crate::figures::model_color;
+use crate::figures::{model_color, power_label};
 use crate::output::write_atomic;
 use anyhow::{Context, Result, anyhow};
 use cdpr_core::Vector2;
@@ -99,6 +99,14 @@ fn loop_name(l: Loop) -> &'static str {
 }
 
 impl ModesReport {
+    /// The effector positions analysed, in order (each has a closed- and an open-loop analysis
+    /// per model).
+    fn positions(&self) -> Vec<f64> {
+        let mut xs: Vec<f64> = self.analyses.iter().map(|a| a.x).collect();
+        xs.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+        xs
+    }
+
     /// The taut-string harmonic ω_k = (kπ/l)√(T/μ_s) of either cable nearest a transverse mode's
     /// frequency, as (cable, k, ω_k); None for other kinds. Nearest rather than "the mode's own
     /// cable and rank": at mirror-symmetric positions (x = d/2) the two spans' string modes pair
@@ -177,8 +185,7 @@ impl ModesReport {
             }
             Ok(())
         })?;
-        let mut xs: Vec<f64> = self.analyses.iter().map(|a| a.x).collect();
-        xs.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+        let xs = self.positions();
         for x in xs {
             let closed: Vec<&Analysis> = self
                 .analyses
@@ -247,7 +254,7 @@ impl ModesReport {
             for (rank, m) in transverse.take(2).enumerate() {
                 if let Some((cable, k, t)) = self.taut_string(a, m) {
                     rows.push((
-                        format!("transverse #{}", rank + 1),
+                        format!("transverse #{} ({})", rank + 1, m.kind),
                         m,
                         format!("taut string cable {}, k = {k}: {t:.3}", cable + 1),
                     ));
@@ -263,14 +270,9 @@ impl ModesReport {
                 }
             }
             if let Some(m) = a.least_stable() {
-                rows.push(("**least stable**".into(), m, String::new()));
+                rows.push((format!("**least stable** ({})", m.kind), m, String::new()));
             }
-            for (label, m, reference) in rows {
-                let kind = if label.starts_with("**") || label.starts_with("transverse") {
-                    format!("{label} ({})", m.kind)
-                } else {
-                    label
-                };
+            for (kind, m, reference) in rows {
                 writeln!(
                     w,
                     "| {} | {} | {} | {} | {:.4} | {:+.4e} | {:.3e} | {:.3} | {} |",
@@ -286,8 +288,7 @@ impl ModesReport {
                 )?;
             }
         }
-        let mut xs: Vec<f64> = self.analyses.iter().map(|a| a.x).collect();
-        xs.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+        let xs = self.positions();
         writeln!(w)?;
         for x in xs {
             writeln!(
@@ -395,13 +396,6 @@ where
         .y_label_area_size(px(80.0))
         .build_cartesian_2d(-1.0f64..6.0, y_lo..y_hi)
         .map_err(err)?;
-    let x_fmt = |v: &f64| {
-        if (v - v.round()).abs() < 1e-9 {
-            format!("1e{}", v.round() as i64)
-        } else {
-            String::new()
-        }
-    };
     let y_fmt = |v: &f64| symlog_label(*v);
     chart
         .configure_mesh()
@@ -409,7 +403,7 @@ where
         .y_desc("ζ = −σ/|λ| (symmetric log)")
         .x_labels(8)
         .y_labels(((y_hi - y_lo).ceil() as usize) + 1)
-        .x_label_formatter(&x_fmt)
+        .x_label_formatter(&power_label)
         .y_label_formatter(&y_fmt)
         .label_style(font.clone())
         .axis_desc_style(font.clone())

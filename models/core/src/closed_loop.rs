@@ -144,8 +144,14 @@ impl<M: CableModel> ClosedLoop<M> {
     /// at x_ref(0) and F0 unknown, velocities zero, w(0) = F0/I, f(0) = e(0) = 0, audits zero.
     /// Without integral action (I = 0) no controller state holds F0; w(0) = 0 then.
     pub fn initial_state(&mut self) -> Result<(Vec<f64>, Equilibrium), ModelError> {
-        let x0 = self.trajectory.position(0.0);
-        let eq = self.model.equilibrium(x0, self.distribution.tension_sum)?;
+        self.rest_state(self.trajectory.position(0.0))
+    }
+
+    /// The closed loop at rest with the effector at x [m]: the model's static equilibrium there,
+    /// the PID states holding its force F0 (w = F0/I, f = 0), audits zero (the start of a run,
+    /// and the point a linearisation is taken about).
+    pub fn rest_state(&mut self, x: f64) -> Result<(Vec<f64>, Equilibrium), ModelError> {
+        let eq = self.model.equilibrium(x, self.distribution.tension_sum)?;
         let pid = self.pid.state_holding(eq.force).unwrap_or_default();
         let mut y = eq.state.clone();
         y.extend_from_slice(&[pid.integral, pid.filter, 0.0, 0.0]);

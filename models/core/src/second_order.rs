@@ -175,6 +175,7 @@ impl ColouredDifferences {
         values: &mut [f64],
     ) -> u64 {
         values.fill(0.0);
+        // A static problem has no q'': its buffer holds the probed unknowns.
         let probe_u = &mut self.qdd;
         probe_u.copy_from_slice(u);
         let mut evals = 0;

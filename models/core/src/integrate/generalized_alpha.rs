@@ -325,22 +325,22 @@ impl GeneralizedAlpha {
         Ok(())
     }
 
-    /// Modified Newton on R(q''_{n+1}) = 0 with the current factorisation of S. `fresh`: S was
-    /// evaluated for this step, so a slow contraction means the step is too long for Newton,
-    /// not that S has aged (see [`FRESH_CONTRACTION`]).
+    /// Modified Newton on R(q''_{n+1}) = 0 with the current factorisation of S, to max |R| ≤ `tol`.
+    /// `fresh`: S was evaluated for this step, so a slow contraction means the step is too long
+    /// for Newton, not that S has aged (see [`FRESH_CONTRACTION`]).
     fn newton<S: SecondOrderSystem + ?Sized>(
         &mut self,
         sys: &mut S,
         t: f64,
         h: f64,
         fresh: bool,
+        tol: f64,
     ) -> Newton {
         let limit = if fresh {
             FRESH_CONTRACTION
         } else {
             self.opts.slow_contraction
         };
-        let tol = self.opts.newton_tol.max(sys.residual_round_off(&self.y));
         let mut previous = f64::INFINITY;
         for _ in 0..=self.opts.max_iterations {
             self.kinematics(h);
@@ -353,8 +353,8 @@ impl GeneralizedAlpha {
                 }
                 norm = norm.max(r.abs());
             }
-            // The tolerance of MODELS.md §6, or the forces' round-off where that is larger
-            // (fine stiff meshes: lumped N = 1000 stalls at 1.0–1.3e-7 N against 1e-7 N).
+            // Fine stiff meshes cannot go below their round-off (lumped N = 1000 stalls at
+            // 1.0–1.3e-7 N against 1e-7 N): `tol` accounts for it.
             if norm <= tol {
                 return Newton::Converged;
             }
@@ -477,12 +477,14 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
                 self.refresh(sys, t1, h)?;
                 fresh = true;
             }
-            let mut outcome = self.newton(sys, t1, h, fresh);
+            // The tolerance of MODELS.md §6, or the forces' round-off where that is larger.
+            let tol = self.opts.newton_tol.max(sys.residual_round_off(&self.y));
+            let mut outcome = self.newton(sys, t1, h, fresh, tol);
             if outcome == Newton::Slow && !fresh {
                 // Re-evaluate the matrix at the current iterate and start over from the predictor.
                 self.refresh(sys, t1, h)?;
                 self.predict(h);
-                outcome = self.newton(sys, t1, h, true);
+                outcome = self.newton(sys, t1, h, true, tol);
             }
             self.stats.steps_attempted += 1;
             match outcome {
