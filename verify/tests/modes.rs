@@ -223,6 +223,37 @@ fn first_string_modes_near_the_taut_string() {
     }
 }
 
+/// The linearisation keeps its stencil where the model's forces are smooth. On a fine lumped
+/// mesh a spring's stretch l0·T/EA (≈ 2.8e-6 m at N = 200, T ≈ 100 N) falls below the default
+/// five-point reach 3e-6·|x|, and a stencil on the slack side under-reads the axial stiffness.
+/// Checked by mesh convergence of the one growing axial mode at x = 0.5 (closed loop): from
+/// N = 40 to 120 its frequency moves 0.8 % and its growth 1.6 % (5648 → 5695 rad/s, +0.565 →
+/// +0.556 1/s), so from N = 120 to 200 they must move less: within 1 % and 3 %, and no second
+/// mode may grow faster than 0.01 1/s. Without the model's reach N = 200 had two (+0.146 and
+/// +0.399 1/s at 5669 and 5787 rad/s).
+#[test]
+fn fine_lumped_mesh_keeps_the_axial_mode_converged() {
+    let growing = |elements: i64| {
+        let mut s = scenario(ModelKind::Lumped);
+        s.model.elements = Some(elements);
+        let a = modes::analyse(&s, 0.5, Loop::Closed).unwrap();
+        let fast: Vec<_> = a
+            .modes
+            .iter()
+            .filter(|m| m.mode.growth > 0.01)
+            .map(|m| m.mode)
+            .collect();
+        eprintln!("lumped N = {elements}: growing {fast:?}");
+        fast
+    };
+    let (coarse, fine) = (growing(120), growing(200));
+    assert_eq!(coarse.len(), 1, "{coarse:?}");
+    assert_eq!(fine.len(), 1, "{fine:?}");
+    let (c, f) = (coarse[0], fine[0]);
+    assert!((f.omega / c.omega - 1.0).abs() < 0.01, "{f:?} vs {c:?}");
+    assert!((f.growth / c.growth - 1.0).abs() < 0.03, "{f:?} vs {c:?}");
+}
+
 /// The undamped lumped closed loop at x = 0.6 has exactly one mode growing faster than 0.01 1/s:
 /// the lowest axial stretch mode near 5649 rad/s at ≈ +0.565 1/s (MODELS.md §4, ±1 % and ±5 rad/s;
 /// the other axial modes ≤ 0.005 1/s). FE: the two lowest axial modes grow (FE.9.1: +0.391 1/s at

@@ -25,6 +25,13 @@ pub trait SecondOrderForm {
     fn residual_round_off(&self, _state: &[f64]) -> f64 {
         0.0
     }
+    /// Per position coordinate q_i (`out`, n long), the largest finite-difference step [m] over
+    /// which the forces stay smooth in q_i at `state` = `[q | q']` (∞: nowhere near a kink), e.g. a quarter of
+    /// the stretch of the tension-only springs q_i moves. The models' own iteration matrices use
+    /// it, and so must any other differentiation of them (the modal analysis).
+    fn smooth_reach(&self, _state: &[f64], out: &mut [f64]) {
+        out.fill(f64::INFINITY);
+    }
 
     /// R = M(q) q'' − F(q, q', T) for state `[q | q']` into `r` (n).
     fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]);

@@ -214,6 +214,21 @@ impl SecondOrderForm for Fe {
         spring_round_off(self.material.ea / shortest, &state[..self.positions_len()])
     }
 
+    /// Per coordinate, the smallest [`Fe::block_step_limit`] of the blocks it belongs to (a node:
+    /// its two elements; l_i: every element of its span; ρ_i: the stored element).
+    fn smooth_reach(&self, state: &[f64], out: &mut [f64]) {
+        out.fill(f64::INFINITY);
+        let zeros = vec![0.0; self.positions_len()];
+        for block in self.blocks() {
+            let (dofs, len) = self.block_dofs(block);
+            let [q, _, _] = self.gather(block, &dofs, state, &zeros);
+            let limit = self.block_step_limit(block, &q);
+            for dof in dofs[..len].iter().flatten() {
+                out[*dof] = out[*dof].min(limit);
+            }
+        }
+    }
+
     /// M q'' − F on the assembly of FE.5.5 (before its solve): the tridiagonal node blocks, the
     /// l-columns C and the border block D.
     fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]) {

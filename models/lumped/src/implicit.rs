@@ -38,35 +38,6 @@ impl Lumped {
         }
         self.implicit.forces = f;
     }
-
-    /// Per position coordinate, the largest finite-difference step over which its forces are
-    /// smooth (see [`ColouredDifferences`]): a quarter of the smallest |λ − l0| of the springs at
-    /// its node (no probe reaches the tension-only kink; a probe moves a spring's length by at
-    /// most the step) and, at the straddling spring's two ends, ε^(1/3) of the node's distance d
-    /// to the pulley (the path's direction turns on the scale d: truncation (δ/d)² ≈ 4e-11).
-    fn step_limits(&self, state: &[f64], out: &mut [f64]) {
-        let n = self.elements;
-        out.fill(f64::INFINITY);
-        for cable in 0..2 {
-            let r = self.stored[cable];
-            for j in 0..n {
-                let length = self.spring_length(state, cable, j);
-                let mut limit = 0.25 * (length - self.segment).abs();
-                if j + 1 == r {
-                    let pulley = self.pulley(cable);
-                    for node in [j, j + 1] {
-                        let d = (self.node(state, cable, node) - pulley).norm();
-                        limit = limit.min(CBRT_EPSILON * d);
-                    }
-                }
-                for node in [j, j + 1] {
-                    for i in self.coordinates(cable, node) {
-                        out[i] = out[i].min(limit);
-                    }
-                }
-            }
-        }
-    }
 }
 
 impl SecondOrderForm for Lumped {
@@ -119,6 +90,35 @@ impl SecondOrderForm for Lumped {
         spring_round_off(self.stiffness, &state[..self.positions_len()])
     }
 
+    /// Per position coordinate, the largest finite-difference step over which its forces are
+    /// smooth (see [`ColouredDifferences`]): a quarter of the smallest |λ − l0| of the springs at
+    /// its node (no probe reaches the tension-only kink; a probe moves a spring's length by at
+    /// most the step) and, at the straddling spring's two ends, ε^(1/3) of the node's distance d
+    /// to the pulley (the path's direction turns on the scale d: truncation (δ/d)² ≈ 4e-11).
+    fn smooth_reach(&self, state: &[f64], out: &mut [f64]) {
+        let n = self.elements;
+        out.fill(f64::INFINITY);
+        for cable in 0..2 {
+            let r = self.stored[cable];
+            for j in 0..n {
+                let length = self.spring_length(state, cable, j);
+                let mut limit = 0.25 * (length - self.segment).abs();
+                if j + 1 == r {
+                    let pulley = self.pulley(cable);
+                    for node in [j, j + 1] {
+                        let d = (self.node(state, cable, node) - pulley).norm();
+                        limit = limit.min(CBRT_EPSILON * d);
+                    }
+                }
+                for node in [j, j + 1] {
+                    for i in self.coordinates(cable, node) {
+                        out[i] = out[i].min(limit);
+                    }
+                }
+            }
+        }
+    }
+
     fn iteration_matrix(
         &mut self,
         state: &[f64],
@@ -132,7 +132,7 @@ impl SecondOrderForm for Lumped {
             Some(d) => d,
             None => ColouredDifferences::new(self.dofs(), &self.iteration_pattern()),
         };
-        self.step_limits(state, differences.step_limits_mut());
+        self.smooth_reach(state, differences.step_limits_mut());
         let evals = differences.fill(
             &mut |s, a, r| self.residual_into(s, a, tensions, r),
             state,
