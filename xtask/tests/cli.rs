@@ -1,22 +1,17 @@
 //! The command line as a person uses it: files written, errors printed, exit codes.
 
-use std::path::PathBuf;
+mod common;
+
+use common::TempDir;
 use std::process::Command;
 
 fn xtask() -> Command {
     Command::new(env!("CARGO_BIN_EXE_xtask"))
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cdpr-xtask-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 #[test]
 fn simulate_writes_timeseries_and_metrics() {
-    let dir = temp_dir("simulate");
+    let dir = TempDir::new("simulate");
     let scenario = dir.join("short.toml");
     std::fs::write(
         &scenario,
@@ -74,12 +69,11 @@ fn simulate_writes_timeseries_and_metrics() {
         .filter(|e| e.file_name().to_string_lossy().starts_with('.'))
         .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn bad_scenario_is_reported_with_key_and_range() {
-    let dir = temp_dir("bad");
+    let dir = TempDir::new("bad");
     let scenario = dir.join("bad.toml");
     std::fs::write(&scenario, "[robot]\neffector_mass = -1.0\n").unwrap();
     let output = xtask()
@@ -96,12 +90,11 @@ fn bad_scenario_is_reported_with_key_and_range() {
         "{stderr}"
     );
     assert!(!stderr.contains("panicked"), "{stderr}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn unknown_models_are_clear_errors() {
-    let dir = temp_dir("model");
+    let dir = TempDir::new("model");
     for (model, expect) in [("rigid", "unknown model `rigid`"), ("", "unknown model ``")] {
         let output = xtask()
             .args(["simulate", "--model", model, "--out"])
@@ -112,7 +105,6 @@ fn unknown_models_are_clear_errors() {
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(stderr.contains(expect), "{model}: {stderr}");
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `modes --at X`: the three models' modes (CSV with every mode, Markdown with the key ones), the
@@ -120,7 +112,7 @@ fn unknown_models_are_clear_errors() {
 /// must be in the CSV with σ > 0.5 1/s, and the sweep must name a damping for both massive models.
 #[test]
 fn modes_writes_tables_figure_and_sweep() {
-    let dir = temp_dir("modes");
+    let dir = TempDir::new("modes");
     let out = dir.join("out");
     let status = xtask()
         .args(["modes", "--at", "0.6", "--out"])
@@ -170,7 +162,7 @@ fn modes_writes_tables_figure_and_sweep() {
 /// An effector position outside the workspace is a clear error and a non-zero exit.
 #[test]
 fn modes_outside_the_workspace_is_an_error() {
-    let dir = temp_dir("modes-bad");
+    let dir = TempDir::new("modes-bad");
     let status = xtask()
         .args(["modes", "--at", "1.5", "--out"])
         .arg(dir.join("out"))

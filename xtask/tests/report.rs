@@ -1,6 +1,9 @@
 //! `cargo xtask report` on a short scenario into a temporary directory: every file exists, the
 //! PNGs decode at the right size, the SVGs parse, REPORT.md has a row per §8 quantity and model.
 
+mod common;
+
+use common::TempDir;
 use std::path::Path;
 use std::process::Command;
 
@@ -48,9 +51,7 @@ fn report(dir: &Path) -> std::process::Output {
 
 #[test]
 fn report_writes_every_figure_table_and_file() {
-    let dir = std::env::temp_dir().join(format!("cdpr-report-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("report");
     let output = report(&dir);
     assert!(
         output.status.success(),
@@ -129,5 +130,4 @@ fn report_writes_every_figure_table_and_file() {
         .filter(|e| e.file_name().to_string_lossy().starts_with('.'))
         .collect();
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
