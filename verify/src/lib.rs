@@ -63,6 +63,8 @@ pub struct Assessed {
     /// [rad/s]: 5649 rad/s for DOPRI5, its generalised-α image (period-elongated) on the implicit
     /// path.
     pub axial_mode_seen: f64,
+    /// The integrator that ran it.
+    pub integrator: IntegratorKind,
 }
 
 /// How the scenario's integrator renders an undamped mode of frequency `omega` [rad/s]: unchanged
@@ -88,6 +90,7 @@ impl Assessed {
             metrics: &self.metrics,
             vertical_mode: self.end.mode.omega,
             axial_mode: self.axial_mode_seen,
+            integrator: self.integrator,
         }
     }
 }
@@ -103,6 +106,7 @@ pub fn assess(
         metrics: metrics(scenario, &run),
         end: end_state(scenario)?,
         axial_mode_seen: mode_as_integrated(scenario, acceptance::LUMPED_AXIAL_MODE),
+        integrator: scenario.simulation.integrator,
         run,
     })
 }

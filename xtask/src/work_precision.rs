@@ -29,7 +29,7 @@ const REFERENCE_RTOL: f64 = 1e-10;
 /// One point of the study.
 struct Point {
     model: ModelKind,
-    integrator: &'static str,
+    integrator: IntegratorKind,
     /// rtol (DOPRI5) or step [s] (implicit).
     parameter: f64,
     error: f64,
@@ -93,10 +93,7 @@ pub fn run_study(out: &Path) -> Result<()> {
             let r = run(&scenario(model, integrator, parameter)?)?;
             let point = Point {
                 model,
-                integrator: match integrator {
-                    IntegratorKind::Dopri5 => "dopri5",
-                    IntegratorKind::Implicit => "implicit",
-                },
+                integrator,
                 parameter,
                 error: error(&r, &reference)?,
                 wall_s: r.wall_s,
@@ -107,7 +104,10 @@ pub fn run_study(out: &Path) -> Result<()> {
             };
             eprintln!(
                 "{model} {} {parameter:e}: error {:.3e} m, {:.4} s, {} RHS",
-                point.integrator, point.error, point.wall_s, point.rhs_evals
+                point.integrator.name(),
+                point.error,
+                point.wall_s,
+                point.rhs_evals
             );
             points.push(point);
         }
@@ -122,7 +122,7 @@ pub fn run_study(out: &Path) -> Result<()> {
                 w,
                 "{},{},{},{},{},{},{},{},{}",
                 p.model,
-                p.integrator,
+                p.integrator.name(),
                 p.parameter,
                 p.error,
                 p.wall_s,
@@ -143,19 +143,20 @@ pub fn run_study(out: &Path) -> Result<()> {
             .into_iter()
             .flat_map(|model| {
                 let points = &points;
-                ["dopri5", "implicit"]
+                [IntegratorKind::Dopri5, IntegratorKind::Implicit]
                     .into_iter()
                     .map(move |integrator| Line {
                         label: format!(
                             "{model}, {}",
-                            if integrator == "dopri5" {
-                                "DOPRI5 (rtol 1e-4 … 1e-8)"
-                            } else {
-                                "generalised-α ρ∞ = 0.9 (h 4e-4 … 1.25e-5 s)"
+                            match integrator {
+                                IntegratorKind::Dopri5 => "DOPRI5 (rtol 1e-4 … 1e-8)",
+                                IntegratorKind::Implicit => {
+                                    "generalised-α ρ∞ = 0.9 (h 4e-4 … 1.25e-5 s)"
+                                }
                             }
                         ),
                         color: figures::model_color(model.name()),
-                        dashed: integrator == "implicit",
+                        dashed: integrator == IntegratorKind::Implicit,
                         points: points
                             .iter()
                             .filter(|p| p.model == model && p.integrator == integrator)

@@ -529,7 +529,7 @@ fn integrate_and_sample<M: CableModel>(
     let outcome =
         if opts.integrator == IntegratorKind::Implicit && sys.model.second_order().is_none() {
             Err(RunError::Unsupported {
-                integrator: "implicit",
+                integrator: IntegratorKind::Implicit.name(),
                 model: sys.model.name(),
                 why: "the model offers no second-order form",
             })

@@ -266,6 +266,16 @@ pub enum IntegratorKind {
     Implicit,
 }
 
+impl IntegratorKind {
+    /// The scenario file's spelling.
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Dopri5 => "dopri5",
+            IntegratorKind::Implicit => "implicit",
+        }
+    }
+}
+
 /// Implicit method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
 pub enum ImplicitMethod {
