@@ -514,19 +514,12 @@ mod tests {
         assert_eq!(s.border(), &dense_at);
         s.factorise(&values).unwrap();
         let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
-        let mut x = rhs.clone();
-        s.solve_in_place(&mut x);
-        let reference = full
-            .partial_piv_lu()
-            .solve(Mat::from_fn(n, 1, |i, _| rhs[i]));
-        for i in 0..n {
+        for (i, (x, reference)) in solved_and_dense(&mut s, &full, &rhs)
+            .into_iter()
+            .enumerate()
+        {
             // Diagonally dominant interior, O(1) entries: round-off of a 200 × 200 solve.
-            assert!(
-                (x[i] - reference[(i, 0)]).abs() < 1e-12,
-                "{i}: {} vs {}",
-                x[i],
-                reference[(i, 0)]
-            );
+            assert!((x - reference).abs() < 1e-12, "{i}: {x} vs {reference}");
         }
     }
 
@@ -557,21 +550,30 @@ mod tests {
             "the test matrix must make the LU pivot"
         );
         let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
-        let mut x = rhs.clone();
-        s.solve_in_place(&mut x);
-        let reference = full
-            .partial_piv_lu()
-            .solve(Mat::from_fn(n, 1, |i, _| rhs[i]));
-        for i in 0..n {
+        for (i, (x, reference)) in solved_and_dense(&mut s, &full, &rhs)
+            .into_iter()
+            .enumerate()
+        {
             // Both are backward-stable LUs of a 60 × 60 matrix with condition ≲ 1e3: agreement to
             // 1e-10 leaves room for that amplification of round-off.
             assert!(
-                (x[i] - reference[(i, 0)]).abs() < 1e-10 * (1.0 + reference[(i, 0)].abs()),
-                "{i}: {} vs {}",
-                x[i],
-                reference[(i, 0)]
+                (x - reference).abs() < 1e-10 * (1.0 + reference.abs()),
+                "{i}: {x} vs {reference}"
             );
         }
+    }
+
+    /// (S⁻¹ rhs by the factorised `s`, the same by a dense LU of `full`) per entry.
+    fn solved_and_dense(s: &mut IterationMatrix, full: &Mat<f64>, rhs: &[f64]) -> Vec<(f64, f64)> {
+        let mut x = rhs.to_vec();
+        s.solve_in_place(&mut x);
+        let reference = full
+            .partial_piv_lu()
+            .solve(Mat::from_fn(rhs.len(), 1, |i, _| rhs[i]));
+        x.into_iter()
+            .enumerate()
+            .map(|(i, x)| (x, reference[(i, 0)]))
+            .collect()
     }
 
     #[test]
