@@ -168,31 +168,63 @@ pub fn step5_lines(step5: &Step5) -> [Vec<(f64, f64)>; 3] {
     ]
 }
 
+/// Something drawn at a scale (1: the SVG, 2: the PNG, whose bitmap backend does not
+/// anti-alias): the report's figures and the modes' spectrum share [`render_drawing`].
+pub(crate) trait Drawing {
+    fn draw_on<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        scale: f64,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static;
+}
+
+impl Drawing for Figure {
+    fn draw_on<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        scale: f64,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw(root, self, scale)
+    }
+}
+
 /// Writes `figure` as `<dir>/<name>.svg` and `<dir>/<name>.png`, atomically.
 pub fn render(figure: &Figure, dir: &Path) -> Result<()> {
+    render_drawing(figure, &figure.name, dir)
+}
+
+/// Writes `drawing` as `<dir>/<name>.svg` (960 × 640) and `<dir>/<name>.png` (2×), atomically.
+pub(crate) fn render_drawing(drawing: &impl Drawing, name: &str, dir: &Path) -> Result<()> {
     register_fonts();
-    let svg_path = dir.join(format!("{}.svg", figure.name));
+    let svg_path = dir.join(format!("{name}.svg"));
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        draw(&root, figure, 1.0).map_err(|e| anyhow!("drawing {}: {e}", figure.name))?;
+        drawing
+            .draw_on(&root, 1.0)
+            .map_err(|e| anyhow!("drawing {name}: {e}"))?;
         root.present()
-            .map_err(|e| anyhow!("drawing {}: {e:?}", figure.name))?;
+            .map_err(|e| anyhow!("drawing {name}: {e:?}"))?;
     }
     write_atomic(&svg_path, |w| w.write_all(svg.as_bytes()))?;
 
     // The bitmap backend encodes by file extension: draw into a temporary `.png` beside the
     // target, then rename it into place (atomic, like every output).
-    let png_path = dir.join(format!("{}.png", figure.name));
-    let tmp = dir.join(format!(".{}.tmp-{}.png", figure.name, std::process::id()));
+    let png_path = dir.join(format!("{name}.png"));
+    let tmp = dir.join(format!(".{name}.tmp-{}.png", std::process::id()));
     let drawn = (|| {
         let root = BitMapBackend::new(&tmp, (2 * SIZE.0, 2 * SIZE.1)).into_drawing_area();
-        draw(&root, figure, 2.0)?;
+        drawing.draw_on(&root, 2.0)?;
         root.present().map_err(|e| format!("{e:?}"))
     })();
     if let Err(e) = drawn {
         let _ = std::fs::remove_file(&tmp);
-        return Err(anyhow!("drawing {}: {e}", figure.name));
+        return Err(anyhow!("drawing {name}: {e}"));
     }
     std::fs::rename(&tmp, &png_path).with_context(|| format!("writing {}", png_path.display()))
 }

@@ -4,7 +4,7 @@
 //! coefficient C (MODELS.md §4, FE.5.7) that makes every closed-loop mode of the lumped and FE
 //! models decay. The report (`cargo xtask report`) reuses [`ModesReport`] for its modes section.
 
-use crate::figures::{model_color, power_label};
+use crate::figures::{Drawing, model_color, power_label, render_drawing};
 use crate::output::write_atomic;
 use anyhow::{Context, Result, anyhow};
 use cdpr_core::Vector2;
@@ -348,31 +348,29 @@ fn symlog_label(v: f64) -> String {
 /// Frequency |λ| (log) vs damping ratio ζ (symmetric log) of every closed-loop mode at x, one
 /// colour per model; SVG and 2× PNG like the report's figures.
 fn spectrum_figure(analyses: &[&Analysis], x: f64, out: &Path) -> Result<()> {
-    crate::figures::register_fonts();
-    let name = format!("modes_x{x}");
-    let title = format!("Closed-loop modes at x = {x} m: |λ| vs damping ratio ζ (< 0: growing)");
-    let mut svg = String::new();
+    let spectrum = ModeSpectrum {
+        analyses,
+        title: format!("Closed-loop modes at x = {x} m: |λ| vs damping ratio ζ (< 0: growing)"),
+    };
+    render_drawing(&spectrum, &format!("modes_x{x}"), out)
+}
+
+struct ModeSpectrum<'a> {
+    analyses: &'a [&'a Analysis],
+    title: String,
+}
+
+impl Drawing for ModeSpectrum<'_> {
+    fn draw_on<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, plotters::coord::Shift>,
+        scale: f64,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
     {
-        let root = SVGBackend::with_string(&mut svg, (960, 640)).into_drawing_area();
-        draw_spectrum(&root, analyses, &title, 1.0).map_err(|e| anyhow!("drawing {name}: {e}"))?;
-        root.present()
-            .map_err(|e| anyhow!("drawing {name}: {e:?}"))?;
+        draw_spectrum(root, self.analyses, &self.title, scale)
     }
-    write_atomic(&out.join(format!("{name}.svg")), |w| {
-        w.write_all(svg.as_bytes())
-    })?;
-    let png = out.join(format!("{name}.png"));
-    let tmp = out.join(format!(".{name}.tmp-{}.png", std::process::id()));
-    let drawn = (|| {
-        let root = BitMapBackend::new(&tmp, (1920, 1280)).into_drawing_area();
-        draw_spectrum(&root, analyses, &title, 2.0)?;
-        root.present().map_err(|e| format!("{e:?}"))
-    })();
-    if let Err(e) = drawn {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(anyhow!("drawing {name}: {e}"));
-    }
-    std::fs::rename(&tmp, &png).with_context(|| format!("writing {}", png.display()))
 }
 
 fn draw_spectrum<DB: DrawingBackend>(
