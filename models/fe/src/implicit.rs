@@ -173,6 +173,68 @@ impl Fe {
         }
         local
     }
+    /// w_q ∂R/∂q + w_v ∂R/∂q' + w_a ∂R/∂q'' (weights `[w_q, w_v, w_a]`) at (state, qdd), block by
+    /// block in the order of [`SecondOrderForm::iteration_pattern`] (duplicates summed by the
+    /// caller): the iteration matrix S, and with weights [1, 0, 0] the static stiffness.
+    pub(crate) fn block_matrix(
+        &self,
+        state: &[f64],
+        qdd: &[f64],
+        weights: [f64; 3],
+        values: &mut [f64],
+    ) {
+        let mut at = 0;
+        for block in self.blocks() {
+            let (dofs, len) = self.block_dofs(block);
+            let [q, v, a] = self.gather(block, &dofs, state, qdd);
+            let base = self.block_residual(block, &q, &v, &a);
+            let limit = self.block_step_limit(block, &q);
+            // local[row][col] of the weighted sum.
+            let mut local = [[0.0; 5]; 5];
+            for col in 0..len {
+                if dofs[col].is_none() {
+                    continue;
+                }
+                for (which, weight) in weights.into_iter().enumerate() {
+                    if weight == 0.0 {
+                        continue;
+                    }
+                    // q'': linear, one forward difference is exact; q', q: central.
+                    let x = [q, v, a][which][col];
+                    let (plus, minus, width) = if which == 2 {
+                        let mut u = [q, v, a];
+                        u[which][col] = x + x.abs().max(1.0);
+                        let width = u[which][col] - x;
+                        (self.block_residual(block, &u[0], &u[1], &u[2]), base, width)
+                    } else {
+                        let step = central_step(x, if which == 0 { limit } else { f64::INFINITY });
+                        let (mut up, mut down) = ([q, v, a], [q, v, a]);
+                        up[which][col] = x + step;
+                        down[which][col] = x - step;
+                        (
+                            self.block_residual(block, &up[0], &up[1], &up[2]),
+                            self.block_residual(block, &down[0], &down[1], &down[2]),
+                            up[which][col] - down[which][col],
+                        )
+                    };
+                    for row in 0..len {
+                        local[row][col] += weight * (plus[row] - minus[row]) / width;
+                    }
+                }
+            }
+            for row in 0..len {
+                if dofs[row].is_none() {
+                    continue;
+                }
+                for col in 0..len {
+                    if dofs[col].is_some() {
+                        values[at] = local[row][col];
+                        at += 1;
+                    }
+                }
+            }
+        }
+    }
 }
 
 impl SecondOrderForm for Fe {
@@ -274,54 +336,7 @@ impl SecondOrderForm for Fe {
         c_q: f64,
         values: &mut [f64],
     ) -> u64 {
-        let mut at = 0;
-        for block in self.blocks() {
-            let (dofs, len) = self.block_dofs(block);
-            let [q, v, a] = self.gather(block, &dofs, state, qdd);
-            let base = self.block_residual(block, &q, &v, &a);
-            let limit = self.block_step_limit(block, &q);
-            // local[row][col] of S.
-            let mut local = [[0.0; 5]; 5];
-            for col in 0..len {
-                if dofs[col].is_none() {
-                    continue;
-                }
-                for (which, weight) in [(0, c_q), (1, c_v), (2, 1.0)] {
-                    // q'': linear, one forward difference is exact; q', q: central.
-                    let x = [q, v, a][which][col];
-                    let (plus, minus, width) = if which == 2 {
-                        let mut u = [q, v, a];
-                        u[which][col] = x + x.abs().max(1.0);
-                        let width = u[which][col] - x;
-                        (self.block_residual(block, &u[0], &u[1], &u[2]), base, width)
-                    } else {
-                        let step = central_step(x, if which == 0 { limit } else { f64::INFINITY });
-                        let (mut up, mut down) = ([q, v, a], [q, v, a]);
-                        up[which][col] = x + step;
-                        down[which][col] = x - step;
-                        (
-                            self.block_residual(block, &up[0], &up[1], &up[2]),
-                            self.block_residual(block, &down[0], &down[1], &down[2]),
-                            up[which][col] - down[which][col],
-                        )
-                    };
-                    for row in 0..len {
-                        local[row][col] += weight * (plus[row] - minus[row]) / width;
-                    }
-                }
-            }
-            for row in 0..len {
-                if dofs[row].is_none() {
-                    continue;
-                }
-                for col in 0..len {
-                    if dofs[col].is_some() {
-                        values[at] = local[row][col];
-                        at += 1;
-                    }
-                }
-            }
-        }
+        self.block_matrix(state, qdd, [c_q, c_v, 1.0], values);
         // One base and 5 × (1 + 2 + 2) probes per block: the cost of about 26 residual sweeps.
         26
     }
