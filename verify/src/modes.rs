@@ -321,7 +321,11 @@ pub fn linearise_model<M: CableModel + ModalLayout>(
     if let Some(form) = sys.model.second_order() {
         form.smooth_reach(&y[..n], &mut reach[..np]);
     }
-    let jac = modal::jacobian_within(&mut sys, 0.0, &y, n + 2, &reach);
+    // Velocities at rest: a step scale of 1 m/s (the step5 peak speed is 0.94 m/s), see
+    // `modal::jacobian_within`.
+    let mut scale = vec![1e-3; n + 2];
+    scale[np..n].fill(1.0);
+    let jac = modal::jacobian_within(&mut sys, 0.0, &y, n + 2, &reach, &scale);
     let shapes = modal::mode_shapes(&modal::reduce(&jac, &keep))?;
     let mut modes = Vec::with_capacity(shapes.len());
     let mut vectors = Vec::with_capacity(shapes.len());
@@ -467,15 +471,15 @@ pub struct Sweep {
 /// bisection on log C to a relative width of 1e-3 from the last unstable scan point.
 ///
 /// Why a threshold and not σ < 0: axial (Kelvin–Voigt) damping barely touches the transverse
-/// string modes (they hardly stretch), so they stay near neutral, and with C > 0 the Jacobian is
-/// strongly non-normal (overdamped axial modes with real eigenvalues up to ~1e6 1/s next to
-/// neutral string modes): the string modes' computed σ then scatter erratically at the 1e-3 1/s
-/// level (measured at x = 0.6: up to +1.9e-3 1/s, non-monotonic in C, e.g. +1.3e-3 at C = 0.4958
-/// and +0.7e-3 at 0.4966 N s), far above the undamped resolution ([`growth_resolution`], ~1e-11
-/// 1/s). "< 0" would be decided by that scatter. The caller's threshold should sit above it and
-/// below the undamped axial growth (0.16–0.57 1/s, MODELS.md §4, FE.9.1): the xtask uses 1e-2 1/s
-/// (≤ 5 % growth over the 5 s run). The growing axial mode's σ falls about linearly in C (slope
-/// ≈ −90 (1/s)/(N s)), so the threshold moves the answer by ≈ 1e-4 N s from the σ = 0 crossing.
+/// string modes (they hardly stretch), so they stay neutral to within the linearisation's error
+/// (above the answer at x = 0.6: |σ| ≤ 1.8e-6 1/s, lumped and FE), and "< 0" would be decided by
+/// that error. The caller's threshold should sit well above it and below the undamped axial
+/// growth (0.16–0.57 1/s, MODELS.md §4, FE.9.1): the xtask uses 1e-2 1/s (≤ 5 % growth over the
+/// 5 s run). The growing axial mode's σ falls about linearly in C (slope ≈ −97 (1/s)/(N s) for
+/// FE, −90 lumped), so the threshold moves the answer by ≈ 1e-4 N s from the σ = 0 crossing.
+/// (Before the velocity columns were differentiated with a step of their own scale, see
+/// `modal::jacobian_within`, the string modes' σ scattered non-monotonically up to 2e-3 1/s and
+/// the FE answer moved by 0.1 % with the last bits of the equilibrium.)
 pub fn damping_sweep(
     scenario: &Scenario,
     x: f64,

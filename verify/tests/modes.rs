@@ -154,7 +154,7 @@ proptest! {
         let reach: Vec<f64> = (0..2 * n)
             .map(|i| if i < n { 0.25 * (a - chain.segment) } else { f64::INFINITY })
             .collect();
-        let jac = modal::jacobian_within(&mut sys, 0.0, &y, 2 * n, &reach);
+        let jac = modal::jacobian_within(&mut sys, 0.0, &y, 2 * n, &reach, &[]);
         let shapes = modal::mode_shapes(&jac).unwrap();
         let (mut transverse, mut axial) = (Vec::new(), Vec::new());
         for s in &shapes {
@@ -252,6 +252,38 @@ fn fine_lumped_mesh_keeps_the_axial_mode_converged() {
     let (c, f) = (coarse[0], fine[0]);
     assert!((f.omega / c.omega - 1.0).abs() < 0.01, "{f:?} vs {c:?}");
     assert!((f.growth / c.growth - 1.0).abs() < 0.03, "{f:?} vs {c:?}");
+}
+
+/// With axial (Kelvin–Voigt) damping no transverse string mode grows: they hardly stretch, so
+/// the damping barely reaches them (the most damped one sits at σ ≈ −3.3e-4 1/s whatever C),
+/// and nothing else drives them. Over C = 7.5e-3 … 1 N s at x = 0.6 (closed loop, both massive models)
+/// every string mode below 1e4 rad/s must have σ < 1e-4 1/s: two decades under the sweep's
+/// 1e-2 1/s threshold and 50× above the largest σ the linearisation shows (1.8e-6 1/s). A
+/// velocity step at the position floor (1.5e-9 m/s) put 1e-4 relative round-off on the damping
+/// forces and scattered these σ up to +2e-3 1/s (e.g. FE at C = 0.316 N s: +1.25e-3 1/s).
+#[test]
+fn damped_string_modes_do_not_grow() {
+    for kind in [ModelKind::Lumped, ModelKind::Fe] {
+        for c in [7.5e-3, 3.16e-2, 0.1, 0.316, 1.0] {
+            let mut s = scenario(kind);
+            s.cable.axial_damping = c;
+            let a = modes::analyse(&s, 0.6, Loop::Closed).unwrap();
+            let sigma: Vec<f64> = a
+                .modes
+                .iter()
+                .filter(|m| matches!(m.kind, ModeKind::Transverse(_)))
+                .filter(|m| m.mode.omega < modes::RELEVANT_BAND)
+                .map(|m| m.mode.growth)
+                .collect();
+            let (lo, hi) = sigma
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &g| {
+                    (l.min(g), h.max(g))
+                });
+            eprintln!("{kind:?} at C = {c} N s: string-mode σ in [{lo:e}, {hi:e}] 1/s");
+            assert!(hi < 1e-4, "{kind:?} at C = {c} N s: σ up to {hi:e} 1/s");
+        }
+    }
 }
 
 /// The undamped lumped closed loop at x = 0.6 has exactly one mode growing faster than 0.01 1/s:

@@ -305,13 +305,20 @@ impl ModesReport {
                     s.points.last().map_or(f64::NAN, |p| p.damping)
                 ),
             };
+            // How neutral the modes left above the answer are (the string modes).
+            let above = s
+                .points
+                .iter()
+                .filter(|p| s.smallest.is_some_and(|c| p.damping >= c))
+                .filter(|p| matches!(p.least_stable.kind, ModeKind::Transverse(_)))
+                .fold(0.0f64, |m, p| m.max(p.least_stable.mode.growth.abs()));
             writeln!(
                 w,
                 "- {} at x = {}: {at} is the smallest Kelvin–Voigt coefficient for which every \
                  closed-loop mode has σ ≤ {:.0e} 1/s (linearisation resolution {:.1e} 1/s; \
                  {} points in `damping_sweep.csv`). Above it the least stable modes are transverse \
-                 string modes, neutral to within the eigen-solver's scatter on these damped \
-                 Jacobians (|σ| ≲ 2e-3 1/s); axial damping does not reach them.",
+                 string modes, neutral to within |σ| ≤ {above:.1e} 1/s; axial damping does not \
+                 reach them.",
                 s.model,
                 s.x,
                 s.threshold,
