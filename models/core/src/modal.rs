@@ -10,6 +10,7 @@
 use crate::closed_loop::ClosedLoop;
 use crate::integrate::OdeSystem;
 use crate::model::CableModel;
+use crate::second_order::CBRT_EPSILON;
 use faer::{Mat, c64};
 
 pub use faer::linalg::evd::EvdError;
@@ -92,7 +93,7 @@ pub fn jacobian_within<S: OdeSystem>(
     for j in 0..n {
         let limit = reach.get(j).map_or(f64::INFINITY, |r| 0.5 * r);
         let floor = scale.get(j).copied().unwrap_or(1e-3);
-        let h0 = (0.25 * f64::EPSILON.cbrt() * y[j].abs().max(floor)).min(limit);
+        let h0 = (0.25 * CBRT_EPSILON * y[j].abs().max(floor)).min(limit);
         // The step actually taken (y + h is rounded).
         let h = (y[j] + h0) - y[j];
         for (k, o) in [2.0, 1.0, -1.0, -2.0].into_iter().enumerate() {

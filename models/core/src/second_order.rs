@@ -239,10 +239,15 @@ impl ColouredDifferences {
                             1 => (&mut self.state[n + c], state[n + c]),
                             _ => (&mut self.state[c], state[c]),
                         };
-                        let step = if derivative == 2 {
-                            central_step(original, self.step_limits[c])
-                        } else if central {
-                            central_step(original, f64::INFINITY)
+                        let step = if central {
+                            // Positions keep within the model's smooth reach; velocities have
+                            // no kink.
+                            let limit = if derivative == 2 {
+                                self.step_limits[c]
+                            } else {
+                                f64::INFINITY
+                            };
+                            central_step(original, limit)
                         } else {
                             original.abs().max(1.0)
                         };

@@ -23,7 +23,10 @@ struct Problem<'a> {
     /// The model's second-order pattern over q and, per entry, its ∂R/∂q (Jacobian scratch).
     dynamic: Vec<(usize, usize)>,
     stiffness: Vec<f64>,
-    /// Residual scratch for F0's column.
+    /// Scratch of the Jacobian: q'' = 0 (at rest), the unknowns with F0 moved, and the residuals
+    /// for F0's column.
+    at_rest: Vec<f64>,
+    moved: Vec<f64>,
     base: Vec<f64>,
     pulled: Vec<f64>,
 }
@@ -88,9 +91,8 @@ impl StaticProblem for Problem<'_> {
     /// F0 through T_i = (ΣT ∓ F0)/2).
     fn jacobian(&mut self, u: &[f64], values: &mut [f64]) -> bool {
         self.load(u);
-        let qdd = vec![0.0; self.model.positions_len()];
         self.model
-            .block_matrix(&self.y, &qdd, [1.0, 0.0, 0.0], &mut self.stiffness);
+            .block_matrix(&self.y, &self.at_rest, [1.0, 0.0, 0.0], &mut self.stiffness);
         let p = self.model.effector_index();
         let mut at = 0;
         for (&(_, col), &k) in self.dynamic.iter().zip(&self.stiffness) {
@@ -100,12 +102,13 @@ impl StaticProblem for Problem<'_> {
             }
         }
         let force = self.map.len();
-        let (mut base, mut pulled) = (
+        let (mut base, mut pulled, mut moved) = (
             std::mem::take(&mut self.base),
             std::mem::take(&mut self.pulled),
+            std::mem::take(&mut self.moved),
         );
         self.residual(u, &mut base);
-        let mut moved = u.to_vec();
+        moved.copy_from_slice(u);
         moved[force] += 1.0;
         self.residual(&moved, &mut pulled);
         self.load(u);
@@ -113,7 +116,7 @@ impl StaticProblem for Problem<'_> {
             values[at] = pulled[row] - base[row];
             at += 1;
         }
-        (self.base, self.pulled) = (base, pulled);
+        (self.base, self.pulled, self.moved) = (base, pulled, moved);
         true
     }
     /// 1e-4 m for lengths: a 6e-10 m step, far inside an element's stretch (ε h = 2.8e-5 m at
@@ -202,6 +205,8 @@ fn problem(
         map,
         stiffness: vec![0.0; dynamic.len()],
         dynamic,
+        at_rest: vec![0.0; np],
+        moved: vec![0.0; unknowns],
         base: vec![0.0; unknowns],
         pulled: vec![0.0; unknowns],
     };

@@ -250,7 +250,7 @@ impl IterationMatrix {
     pub fn solve_in_place(&mut self, rhs: &mut [f64]) {
         debug_assert!(self.factorised);
         let ni = self.interior.len();
-        // y = A⁻¹ r_A (gathered from the global numbering by the repacked factors).
+        // y = A⁻¹ r_A, gathered from the global numbering.
         self.substitution
             .solve(&self.numeric, rhs, true, &mut self.interior_rhs);
         if let Some(schur) = &self.schur {
@@ -438,7 +438,7 @@ mod tests {
         }
     }
 
-    /// Small diagonal, O(1) neighbours: partial pivoting swaps rows, so the repacked solve's
+    /// Small diagonal, O(1) neighbours: partial pivoting swaps rows, so the solve's
     /// gather (row pivots) and scatter (column ordering) are both exercised.
     #[test]
     fn pivoted_banded_system_matches_dense_lu() {

@@ -174,8 +174,6 @@ pub fn applied(m: &Fe, tensions: [f64; 2]) -> Vec<f64> {
     q
 }
 
-/// Commanded tensions that wobble around 100 N at 3 and 7 Hz with a phase offset between the
-/// cables (energy-balance runs: they pump work through both reels and excite the cable).
 /// DOPRI5 (β = 0, rtol, atol) from the model state `y` (controller and audit states appended as
 /// zeros) under [`wobbling_tensions`], to `t_final` [s] sampled every 1e-4 s, and the largest
 /// |E − E0 − W + D| of the run [J]: the energy identity the FE tests audit.
@@ -210,6 +208,8 @@ pub fn column_max_abs(run: &cdpr_core::closed_loop::Run, channel: &str) -> f64 {
     values.iter().fold(0.0f64, |a, v| a.max(v.abs()))
 }
 
+/// Commanded tensions that wobble around 100 N at 3 and 7 Hz with a phase offset between the
+/// cables (energy-balance runs: they pump work through both reels and excite the cable).
 pub fn wobbling_tensions() -> cdpr_core::closed_loop::Actuation {
     let pi = std::f64::consts::PI;
     cdpr_core::closed_loop::Actuation::Prescribed(Box::new(move |t| {
