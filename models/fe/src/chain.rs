@@ -45,21 +45,19 @@ impl FixedCable {
         let k = MassCoefficients::new(FeMass::Consistent, 1.0, 1.0);
         for e in 1..=n {
             let (ra, rb) = (self.node(interior, e - 1), self.node(interior, e));
-            let s = ElementState {
-                ra,
-                rb,
-                va: Vector2::zeros(),
-                vb: Vector2::zeros(),
-                l_rate: 0.0,
+            let s = ElementState::new(
+                (ra, Vector2::zeros()),
+                (rb, Vector2::zeros()),
+                0.0,
                 h,
-                h_prime: 1.0 / n as f64,
-            };
+                1.0 / n as f64,
+            );
             let mut t = element::terms(mat, &k, &s);
             if bilateral {
                 let d = rb - ra;
                 let len = d.norm();
-                let (_, tension) = element::tension(mat.ea, len, h);
-                let push = d * ((mat.ea * (len / h - 1.0) - tension) / len);
+                let (strain, tension) = s.tension(mat.ea, len);
+                let push = d * ((mat.ea * strain - tension) / len);
                 t.fa += push;
                 t.fb -= push;
             }

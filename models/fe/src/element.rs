@@ -56,7 +56,11 @@ pub struct Material {
 }
 
 /// One element's configuration: node positions [m] and velocities [m/s], the span's l' [m/s],
-/// the element's unstrained length h [m] and h' = dh/dl.
+/// the element's unstrained length h [m], its inverse 1/h [1/m] and h' = dh/dl.
+///
+/// 1/h is carried rather than recomputed because the N elements of a span share h: the span
+/// divides once and every element multiplies (divisions and square roots share one slow unit, and
+/// they were most of an element's cost). Build it with [`ElementState::new`] unless 1/h is at hand.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ElementState {
     pub ra: Vector2<f64>,
@@ -65,7 +69,39 @@ pub struct ElementState {
     pub vb: Vector2<f64>,
     pub l_rate: f64,
     pub h: f64,
+    pub inv_h: f64,
     pub h_prime: f64,
+}
+
+impl ElementState {
+    /// Nodes (r_a, v_a), (r_b, v_b), the span's l', unstrained length h and h'.
+    #[inline]
+    pub fn new(
+        (ra, va): (Vector2<f64>, Vector2<f64>),
+        (rb, vb): (Vector2<f64>, Vector2<f64>),
+        l_rate: f64,
+        h: f64,
+        h_prime: f64,
+    ) -> Self {
+        Self {
+            ra,
+            rb,
+            va,
+            vb,
+            l_rate,
+            h,
+            inv_h: 1.0 / h,
+            h_prime,
+        }
+    }
+
+    /// Strain ε = |Δ|/h − 1 and tension N = EA max(ε, 0) (FE.2, FE.1.4: tension only) for the
+    /// chord length |Δ| = `length` [m].
+    #[inline]
+    pub fn tension(&self, ea: f64, length: f64) -> (f64, f64) {
+        let strain = length * self.inv_h - 1.0;
+        (strain, ea * strain.max(0.0))
+    }
 }
 
 /// What an element adds to M and F (FE.5.3), in its local unknowns (r_a, r_b, l).
@@ -86,13 +122,6 @@ pub struct ElementTerms {
     pub fl: f64,
 }
 
-/// Element strain ε = |Δ|/h − 1 and tension N = EA max(ε, 0) (FE.2, FE.1.4: tension only).
-#[inline]
-pub fn tension(ea: f64, length: f64, h: f64) -> (f64, f64) {
-    let strain = length / h - 1.0;
-    (strain, ea * strain.max(0.0))
-}
-
 /// M_e and F_e of MODELS.md FE.5.3 for one element (no axial damping).
 #[inline]
 pub fn terms(mat: &Material, k: &MassCoefficients, s: &ElementState) -> ElementTerms {
@@ -105,8 +134,8 @@ pub fn terms(mat: &Material, k: &MassCoefficients, s: &ElementState) -> ElementT
 pub fn strain_rate(s: &ElementState) -> f64 {
     let delta = s.rb - s.ra;
     let len = delta.norm();
-    let strain = len / s.h - 1.0;
-    delta.dot(&(s.vb - s.va)) / (len * s.h) - (1.0 + strain) * s.h_prime * s.l_rate / s.h
+    let strain = len * s.inv_h - 1.0;
+    (delta.dot(&(s.vb - s.va)) / len - (1.0 + strain) * s.h_prime * s.l_rate) * s.inv_h
 }
 
 /// The Kelvin–Voigt part of the element tension (MODELS.md FE.5.7) for damping C [N s]:
@@ -117,7 +146,7 @@ pub fn damping_tension(mat: &Material, s: &ElementState, damping: f64) -> (f64, 
     if damping == 0.0 {
         return (0.0, 0.0);
     }
-    let strain = (s.rb - s.ra).norm() / s.h - 1.0;
+    let strain = (s.rb - s.ra).norm() * s.inv_h - 1.0;
     if strain <= 0.0 {
         return (0.0, 0.0);
     }
@@ -138,7 +167,7 @@ pub fn dissipation(mat: &Material, s: &ElementState, damping: f64) -> f64 {
 /// `damping` [N s]: the damping tension N_d acts along t like N_e on F_a, F_b, and adds
 /// h' N_d (1 + ε) to F_l (the virtual work −h N_d δε with δε = t·δΔ/h − (1 + ε) h' δl/h; note
 /// (1 + ε), not the (1 + ε/2) of the elastic term, which comes from the strain energy's h).
-#[inline]
+#[inline(always)]
 pub fn terms_damped(
     mat: &Material,
     k: &MassCoefficients,
@@ -151,13 +180,13 @@ pub fn terms_damped(
     let delta = s.rb - s.ra;
     let len2 = delta.norm_squared();
     let len = len2.sqrt();
-    let (strain, n) = tension(mat.ea, len, h);
+    let (strain, n) = s.tension(mat.ea, len);
     let (n_damp, _) = damping_tension(mat, s, damping);
     // (N + N_d) t with t = Δ/|Δ|: the pull on node a towards b.
     let pull = delta * ((n + n_damp) / len);
     let h_rate = s.h_prime * ld;
     let delta_rate = b - a;
-    let inv_h = 1.0 / h;
+    let inv_h = s.inv_h;
     let flux = a * k.alpha + b * k.beta;
     // G = μ l'(α a + β b) + μ γ l'² Δ/h.
     let g = (flux * ld + delta * (k.gamma * ld * ld * inv_h)) * mu;
@@ -203,8 +232,8 @@ pub fn energies(mat: &Material, k: &MassCoefficients, s: &ElementState) -> (f64,
     let kinetic =
         0.5 * mu * h * (k.c1 * (a.norm_squared() + b.norm_squared()) + 2.0 * k.c2 * a.dot(&b))
             + mu * ld * (a * k.alpha + b * k.beta).dot(&delta)
-            + 0.5 * mu * k.gamma * ld * ld * len2 / h;
-    let strain = (len2.sqrt() / h - 1.0).max(0.0);
+            + 0.5 * mu * k.gamma * ld * ld * len2 * s.inv_h;
+    let strain = (len2.sqrt() * s.inv_h - 1.0).max(0.0);
     let elastic = 0.5 * mat.ea * h * strain * strain;
     let gravity = mu * mat.gravity * h * 0.5 * (s.ra.y + s.rb.y);
     (kinetic, elastic, gravity)

@@ -107,15 +107,13 @@ impl Fe {
         match block {
             Block::Free { cable: _, e } => {
                 let n = self.elements as f64;
-                let s = ElementState {
-                    ra: Vector2::new(q[0], q[1]),
-                    rb: Vector2::new(q[2], q[3]),
-                    va: Vector2::new(v[0], v[1]),
-                    vb: Vector2::new(v[2], v[3]),
-                    l_rate: v[4],
-                    h: q[4] / n,
-                    h_prime: 1.0 / n,
-                };
+                let s = ElementState::new(
+                    (Vector2::new(q[0], q[1]), Vector2::new(v[0], v[1])),
+                    (Vector2::new(q[2], q[3]), Vector2::new(v[2], v[3])),
+                    v[4],
+                    q[4] / n,
+                    1.0 / n,
+                );
                 let t =
                     element::terms_damped(mat, &self.coefficients[e - 1], &s, self.axial_damping);
                 let (aa, ab) = (Vector2::new(a[0], a[1]), Vector2::new(a[2], a[3]));
@@ -127,15 +125,13 @@ impl Fe {
             Block::Stored { cable } => {
                 let e_out = Vector2::new(E_OUT[cable], 0.0);
                 let pulley = self.pulley(cable);
-                let s = ElementState {
-                    ra: pulley + e_out * q[0],
-                    rb: pulley,
-                    va: e_out * v[0],
-                    vb: Vector2::zeros(),
-                    l_rate: v[1],
-                    h: self.modelled_length - q[1],
-                    h_prime: -1.0,
-                };
+                let s = ElementState::new(
+                    (pulley + e_out * q[0], e_out * v[0]),
+                    (pulley, Vector2::zeros()),
+                    v[1],
+                    self.modelled_length - q[1],
+                    -1.0,
+                );
                 let t =
                     element::terms_damped(mat, &self.stored_coefficients, &s, self.axial_damping);
                 let m_rho_l = t.m_al.dot(&e_out);

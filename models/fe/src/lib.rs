@@ -191,23 +191,56 @@ impl Fe {
         }
     }
 
+    /// The span's element length h = l_i/N, its inverse and h' = 1/N [m, 1/m, –]: computed once
+    /// per span, since all N free elements share them.
+    #[inline]
+    fn span_length(&self, y: &[f64], cable: usize) -> (f64, f64, f64) {
+        let n = self.elements as f64;
+        let h = y[self.l_index(cable)] / n;
+        (h, 1.0 / h, 1.0 / n)
+    }
+
     /// State of element e (1…N) of `cable`.
     #[inline]
     fn free_element(&self, y: &[f64], cable: usize, e: usize) -> ElementState {
-        let np = self.positions_len();
-        let li = self.l_index(cable);
-        let (ra, va) = self.node(y, cable, e - 1);
-        let (rb, vb) = self.node(y, cable, e);
-        let n = self.elements as f64;
+        let l_rate = y[self.positions_len() + self.l_index(cable)];
+        let (h, inv_h, h_prime) = self.span_length(y, cable);
+        let ((ra, va), (rb, vb)) = (self.node(y, cable, e - 1), self.node(y, cable, e));
         ElementState {
             ra,
             rb,
             va,
             vb,
-            l_rate: y[np + li],
-            h: y[li] / n,
-            h_prime: 1.0 / n,
+            l_rate,
+            h,
+            inv_h,
+            h_prime,
         }
+    }
+
+    /// The N elements of `cable`'s span in order e = 1 (at the pulley) … N (at the effector),
+    /// walking the nodes once: the same states as [`Self::free_element`], bit for bit, without
+    /// re-deriving each node's index and the span's h per element.
+    #[inline]
+    fn span<'a>(&'a self, y: &'a [f64], cable: usize) -> impl Iterator<Item = ElementState> + 'a {
+        let l_rate = y[self.positions_len() + self.l_index(cable)];
+        let (h, inv_h, h_prime) = self.span_length(y, cable);
+        let mut a = self.node(y, cable, 0);
+        (1..=self.elements).map(move |e| {
+            let b = self.node(y, cable, e);
+            let s = ElementState {
+                ra: a.0,
+                rb: b.0,
+                va: a.1,
+                vb: b.1,
+                l_rate,
+                h,
+                inv_h,
+                h_prime,
+            };
+            a = b;
+            s
+        })
     }
 
     /// State of the elastic stored element of `cable` (R = A + ρ e_out → A), if it exists.
@@ -218,15 +251,13 @@ impl Fe {
         let li = self.l_index(cable);
         let e_out = Vector2::new(E_OUT[cable], 0.0);
         let a = self.pulley(cable);
-        Some(ElementState {
-            ra: a + e_out * y[ri],
-            rb: a,
-            va: e_out * y[np + ri],
-            vb: Vector2::zeros(),
-            l_rate: y[np + li],
-            h: self.modelled_length - y[li],
-            h_prime: -1.0,
-        })
+        Some(ElementState::new(
+            (a + e_out * y[ri], e_out * y[np + ri]),
+            (a, Vector2::zeros()),
+            y[np + li],
+            self.modelled_length - y[li],
+            -1.0,
+        ))
     }
 
     /// Assembles M(q) and F(q, q', T) (FE.5.3) into the block system of FE.5.5.
@@ -238,10 +269,8 @@ impl Fe {
         for cable in 0..2 {
             let lb = sys.l_index[cable];
             let col = 2 + 2 * cable;
-            for e in 1..=n {
-                let s = self.free_element(y, cable, e);
-                let t =
-                    element::terms_damped(&mat, &self.coefficients[e - 1], &s, self.axial_damping);
+            for (e, (s, k)) in (1..=n).zip(self.span(y, cable).zip(&self.coefficients)) {
+                let t = element::terms_damped(&mat, k, &s, self.axial_damping);
                 let ja = self.chain_index(cable, e - 1);
                 let jb = self.chain_index(cable, e).expect("node e ≥ 1 is free");
                 if let Some(ja) = ja {
@@ -368,17 +397,13 @@ impl Fe {
     /// Strain and tension (ε, N_e) of element e (1…N) of `cable` [–, N].
     pub fn element_tension(&self, y: &[f64], cable: usize, e: usize) -> (f64, f64) {
         let s = self.free_element(y, cable, e);
-        element::tension(self.material.ea, (s.rb - s.ra).norm(), s.h)
+        s.tension(self.material.ea, (s.rb - s.ra).norm())
     }
 
     /// Strain and tension of the stored element of `cable` (None for the rigid stored cable).
     pub fn stored_tension(&self, y: &[f64], cable: usize) -> Option<(f64, f64)> {
         let s = self.stored_element(y, cable)?;
-        Some(element::tension(
-            self.material.ea,
-            (s.rb - s.ra).norm(),
-            s.h,
-        ))
+        Some(s.tension(self.material.ea, (s.rb - s.ra).norm()))
     }
 
     /// Unstrained free length l_i [m].
@@ -449,9 +474,8 @@ impl CableModel for Fe {
         let np = self.positions_len();
         let mut e = Energy::default();
         for cable in 0..2 {
-            for el in 1..=self.elements {
-                let s = self.free_element(y, cable, el);
-                let (k, u, g) = element::energies(mat, &self.coefficients[el - 1], &s);
+            for (s, coefficients) in self.span(y, cable).zip(&self.coefficients) {
+                let (k, u, g) = element::energies(mat, coefficients, &s);
                 e.kinetic += k;
                 e.elastic += u;
                 e.gravity += g;
@@ -485,8 +509,8 @@ impl CableModel for Fe {
         let c = self.axial_damping;
         let mut d = 0.0;
         for cable in 0..2 {
-            for e in 1..=self.elements {
-                d += element::dissipation(&self.material, &self.free_element(y, cable, e), c);
+            for s in self.span(y, cable) {
+                d += element::dissipation(&self.material, &s, c);
             }
             if let Some(s) = self.stored_element(y, cable) {
                 d += element::dissipation(&self.material, &s, c);
@@ -521,5 +545,42 @@ impl CableModel for Fe {
             self.stored_length(y, 0),
             self.stored_length(y, 1),
         ]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The span walker must hand the kernels exactly the states `free_element` gives the
+    /// channels (so a reported tension is bit for bit the one in the forces), for both cables'
+    /// numbering directions and both stored variants.
+    #[test]
+    fn span_walk_matches_free_elements_bit_for_bit() {
+        for (elements, stored) in [
+            (1, FeStored::Elastic),
+            (4, FeStored::Rigid),
+            (10, FeStored::Elastic),
+        ] {
+            let mut s = Scenario::paper();
+            s.model.kind = cdpr_core::scenario::ModelKind::Fe;
+            s.model.elements = Some(elements);
+            s.model.fe_stored = stored;
+            let fe = Fe::new(&s).unwrap();
+            let y: Vec<f64> = (0..2 * fe.positions_len())
+                .map(|i| 0.3 + 0.1 * (i as f64 * 0.77).sin())
+                .collect();
+            for cable in 0..2 {
+                let walked: Vec<_> = fe.span(&y, cable).collect();
+                assert_eq!(walked.len(), elements as usize);
+                for (e, state) in (1..).zip(&walked) {
+                    assert_eq!(
+                        *state,
+                        fe.free_element(&y, cable, e),
+                        "cable {cable}, e {e}"
+                    );
+                }
+            }
+        }
     }
 }

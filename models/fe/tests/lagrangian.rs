@@ -198,15 +198,13 @@ proptest! {
         let mat = Material { ea: 179520.0, mu: 0.013816, gravity: 9.81 };
         let h = 0.05;
         let dir = Vector2::new(angle.cos(), angle.sin());
-        let s = ElementState {
-            ra: Vector2::new(0.1, -0.02),
-            rb: Vector2::new(0.1, -0.02) + dir * (h * (1.0 + strain)),
-            va: Vector2::new(va, vb),
-            vb: Vector2::new(vb, -va),
-            l_rate: ld,
+        let s = ElementState::new(
+            (Vector2::new(0.1, -0.02), Vector2::new(va, vb)),
+            (Vector2::new(0.1, -0.02) + dir * (h * (1.0 + strain)), Vector2::new(vb, -va)),
+            ld,
             h,
-            h_prime: 0.1,
-        };
+            0.1,
+        );
         let k = MassCoefficients::new(FeMass::Consistent, wa, wa * 0.9);
         let with = element::terms(&mat, &k, &s);
         let without = element::terms(&Material { ea: 0.0, ..mat }, &k, &s);
