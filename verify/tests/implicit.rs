@@ -113,6 +113,46 @@ proptest! {
     }
 }
 
+/// The layout the iteration matrix keeps for the paper's closed loops (deterministic, so a
+/// regression in it shows here rather than as a slower bench). Lumped: the controller's
+/// feedback of the effector's x into both reel rows closes the chains into a loop; with x in
+/// the border and the chain swept from both ends, the sweeps' critical path is ~n (two fronts of
+/// n/2 unknowns each) instead of COLAMD's ~2n (measured 162 against 318 for n = 162, and 1.2
+/// against 2.0 µs per solve), so the path must stay below 1.2 n. FE: the border-free layouts
+/// are cheapest (COLAMD's factors: 659 non-zeros over a 68-long path on the run's first matrix;
+/// with x in the border or in the other order 720–1620), and whichever is kept must not cost
+/// more than that.
+#[test]
+fn paper_iteration_matrices_keep_the_cheapest_layout() {
+    use cdpr_core::closed_loop::ClosedLoop;
+    use cdpr_core::integrate::SecondOrderSystem;
+    use cdpr_core::integrate::sparse::IterationMatrix;
+    for kind in [ModelKind::Lumped, ModelKind::Fe] {
+        let scenario = paper(kind, IntegratorKind::Implicit);
+        let mut sys = ClosedLoop::new(model(&scenario).unwrap(), &scenario);
+        let (y, _) = sys.initial_state().unwrap();
+        let n = sys.dofs();
+        let h = scenario.simulation.step;
+        let (c_v, c_q) = AlphaCoefficients::new(scenario.simulation.rho_inf).derivatives(h);
+        sys.begin_step(0.0, &y, h);
+        let pattern = sys.iteration_pattern();
+        let mut values = vec![0.0; pattern.len()];
+        sys.iteration_matrix(h, &y, &vec![0.0; n], c_v, c_q, &mut values);
+        let coupled = sys.coupled_unknowns();
+        let mut matrix = IterationMatrix::with_coupled(n, &pattern, &coupled).unwrap();
+        matrix.factorise(&values).unwrap();
+        let cost = matrix.solve_cost();
+        eprintln!("{kind}: n = {n}, border {:?}, {cost:?}", matrix.border());
+        match kind {
+            ModelKind::Lumped => {
+                assert_eq!(matrix.border(), coupled.as_slice());
+                assert!(10 * cost.chain < 12 * n, "{cost:?}");
+            }
+            _ => assert!(cost.estimate() <= 660, "{cost:?}"),
+        }
+    }
+}
+
 /// Largest |a − b| over the common samples of a channel [m].
 fn max_difference(a: &[f64], b: &[f64]) -> f64 {
     a.iter()

@@ -192,6 +192,16 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         pattern
     }
 
+    /// The effector's x: the controller feeds it back into the tension rows at the reel ends,
+    /// which closes the cables' chains (reel, …, effector, …, reel) into a loop.
+    fn coupled_unknowns(&self) -> Vec<usize> {
+        self.model
+            .second_order()
+            .filter(|form| !form.tension_rows().is_empty())
+            .map(|form| vec![form.effector_x()])
+            .unwrap_or_default()
+    }
+
     fn begin_step(&mut self, t: f64, y: &[f64], h: f64) {
         let n = self.model_len();
         let cmd = self.command(t, y);

@@ -35,6 +35,12 @@ pub trait SecondOrderSystem: OdeSystem {
     fn dofs(&self) -> usize;
     /// The (row, col) entries of the iteration matrix that may be non-zero, fixed for the run.
     fn iteration_pattern(&self) -> Vec<(usize, usize)>;
+    /// Unknowns that couple distant parts of that pattern (a controller feeding one coordinate
+    /// back into far rows): the matrix eliminates them last, through a Schur complement, so the
+    /// rest keeps its chain structure ([`IterationMatrix::with_coupled`]).
+    fn coupled_unknowns(&self) -> Vec<usize> {
+        Vec::new()
+    }
     /// A step attempt from (t, y) of size h begins: the system records what its tail update and
     /// its residual need from the step's start.
     fn begin_step(&mut self, t: f64, y: &[f64], h: f64);
@@ -443,7 +449,11 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
         }
         let pattern = sys.iteration_pattern();
         self.values = vec![0.0; pattern.len()];
-        self.matrix = Some(IterationMatrix::new(n, &pattern)?);
+        self.matrix = Some(IterationMatrix::with_coupled(
+            n,
+            &pattern,
+            &sys.coupled_unknowns(),
+        )?);
         self.matrix_h = 0.0;
         self.h = self.opts.step;
         self.stats = SolverStats::default();
