@@ -238,10 +238,25 @@ fn implicit_paper_runs_meet_section_8_and_track_dormand_prince() {
         eprintln!("{}: {s:?}", run.kind);
         // The step is set by the physics, not by the axial modes: 5 s / 1e-4 s = 50 000 steps,
         // plus at most 10 % at reduced size around the lumped model's pulley events (a failed
-        // step is halved and needs four successes per doubling back); the matrix is reused.
+        // step is halved and needs four successes per doubling back).
         let nominal = (sim.t_final / sim.step).round() as u64;
         assert!(s.steps_accepted <= nominal + nominal / 10, "{s:?}");
-        assert!(s.factorisations * 20 < s.steps_accepted, "{s:?}");
+        // The matrix is reused, refreshed when convergence slows or once the iterations a stale
+        // matrix costs have paid for a refresh (rent-or-buy). FE's fresh matrix converges in one
+        // iteration for hundreds of steps (measured 1.05 iterations per step, a refresh per 590
+        // steps); the lumped one ages within a step, its first free nodes being 0.2–0.5 mm from
+        // the pulleys (measured 2.17 iterations per step, a refresh per 17 steps). The bounds
+        // leave ~5–10 % for refresh timings, which move with the last bits of the trajectory.
+        let iterations = s.newton_iterations as f64 / s.steps_accepted as f64;
+        let (most_iterations, fewest_steps_per_refresh) = match run.kind {
+            ModelKind::Lumped => (2.4, 10),
+            _ => (1.1, 100),
+        };
+        assert!(iterations <= most_iterations, "{s:?}");
+        assert!(
+            s.factorisations * fewest_steps_per_refresh < s.steps_accepted,
+            "{s:?}"
+        );
 
         // The bound: generalised-α's phase error per radian is (ωh)²/12 to leading order
         // (measured 0.084 (ωh)² by `discrete_mode`). The fastest closed-loop dynamics of the
