@@ -308,11 +308,18 @@ impl GeneralizedAlpha {
         let (w_new, w_old, w_a) = ((1.0 - c.alpha_f) * inv, c.alpha_f * inv, -c.alpha_m * inv);
         let (q_a, q_a1) = (h * h * (0.5 - c.beta), h * h * c.beta);
         let (v_a, v_a1) = (h * (1.0 - c.gamma), h * c.gamma);
+        // Every slice cut to n, so the loop carries no bounds checks and vectorises.
+        let (qdd_try, qdd, a, a_try) = (
+            &self.qdd_try[..n],
+            &self.qdd[..n],
+            &self.a[..n],
+            &mut self.a_try[..n],
+        );
         for i in 0..n {
-            let a1 = w_new * self.qdd_try[i] + w_old * self.qdd[i] + w_a * self.a[i];
-            self.a_try[i] = a1;
-            q1[i] = q0[i] + h * v0[i] + q_a * self.a[i] + q_a1 * a1;
-            v1[i] = v0[i] + v_a * self.a[i] + v_a1 * a1;
+            let a1 = w_new * qdd_try[i] + w_old * qdd[i] + w_a * a[i];
+            a_try[i] = a1;
+            q1[i] = q0[i] + h * v0[i] + q_a * a[i] + q_a1 * a1;
+            v1[i] = v0[i] + v_a * a[i] + v_a1 * a1;
         }
     }
 

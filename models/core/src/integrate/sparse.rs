@@ -57,12 +57,12 @@ pub enum SparseError {
 }
 
 /// Where a declared entry goes: the sparse block A (its compressed-column slot), the border
-/// columns B (interior row, border index), rows C (border index, interior column) or D.
+/// columns B (interior row, border index), rows C (their compressed-row slot) or D.
 #[derive(Debug, Clone, Copy)]
 enum Slot {
     A(usize),
     B(usize, usize),
-    C(usize, usize),
+    C(usize),
     D(usize, usize),
 }
 
@@ -89,10 +89,13 @@ struct Layout {
     pattern: SymbolicSparseColMat<usize>,
     slot: Vec<Slot>,
     values: Vec<f64>,
-    /// B (interior × k, column-major), overwritten by A⁻¹B at each factorisation; C (k × interior,
-    /// row-major); D (k × k).
+    /// B (interior × k, column-major), overwritten by A⁻¹B at each factorisation; C (k × interior)
+    /// by compressed rows, as it has only the few entries of the pattern (a coupled unknown's row:
+    /// its neighbours); D (k × k).
     b: Vec<f64>,
-    c: Vec<f64>,
+    c_ptr: Vec<usize>,
+    c_col: Vec<usize>,
+    c_val: Vec<f64>,
     d: Mat<f64>,
     /// (D − C A⁻¹B)⁻¹ (k × k, row-major): the border is a handful of unknowns, so its inverse
     /// (by faer's LU) makes each solve's border step a k × k product instead of a dense solve
@@ -112,7 +115,7 @@ struct Layout {
 
 /// What a solve costs: the non-zeros of L and U (one multiply-add each), the longest dependency
 /// chain of the two sweeps (unknowns that must wait for one another) and the border's
-/// multiply-adds (C y, the k × k product and A⁻¹B x_B: 2 k n_interior + k², independent).
+/// multiply-adds (C y, the k × k product and A⁻¹B x_B: nnz(C) + k² + k n_interior, independent).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SolveCost {
     pub nonzeros: usize,
@@ -358,6 +361,22 @@ impl Layout {
         for c in 0..ni {
             col_ptr[c + 1] += col_ptr[c];
         }
+        // C's pattern by compressed rows (border row, interior column).
+        let mut c_cells: Vec<(usize, usize)> = entries
+            .iter()
+            .filter(|&&(r, c)| is_border[r] && !is_border[c])
+            .map(|&(r, c)| (local[r], local[c]))
+            .collect();
+        c_cells.sort_unstable();
+        c_cells.dedup();
+        let mut c_ptr = vec![0usize; border.len() + 1];
+        for &(r, _) in &c_cells {
+            c_ptr[r + 1] += 1;
+        }
+        for r in 0..border.len() {
+            c_ptr[r + 1] += c_ptr[r];
+        }
+        let c_col: Vec<usize> = c_cells.iter().map(|&(_, c)| c).collect();
         let slot = entries
             .iter()
             .map(|&(r, c)| match (is_border[r], is_border[c]) {
@@ -369,7 +388,11 @@ impl Layout {
                     )
                 }
                 (false, true) => Slot::B(local[r], local[c]),
-                (true, false) => Slot::C(local[r], local[c]),
+                (true, false) => {
+                    let (lr, lc) = (local[r], local[c]);
+                    let row = &c_col[c_ptr[lr]..c_ptr[lr + 1]];
+                    Slot::C(c_ptr[lr] + row.binary_search(&lc).unwrap_or_else(|_| unreachable!()))
+                }
                 (true, true) => Slot::D(local[r], local[c]),
             })
             .collect();
@@ -395,7 +418,9 @@ impl Layout {
             slot,
             values: vec![0.0; nnz],
             b: vec![0.0; ni * k],
-            c: vec![0.0; k * ni],
+            c_val: vec![0.0; c_col.len()],
+            c_ptr,
+            c_col,
             d: Mat::zeros(k, k),
             schur_inverse: vec![0.0; k * k],
             col_perm,
@@ -417,13 +442,13 @@ impl Layout {
         let (ni, k) = (self.interior.len(), self.border.len());
         self.values.fill(0.0);
         self.b.fill(0.0);
-        self.c.fill(0.0);
+        self.c_val.fill(0.0);
         self.d.fill(0.0);
         for (&slot, &v) in self.slot.iter().zip(entry_values) {
             match slot {
                 Slot::A(s) => self.values[s] += v,
                 Slot::B(i, j) => self.b[j * ni + i] += v,
-                Slot::C(i, j) => self.c[i * ni + j] += v,
+                Slot::C(p) => self.c_val[p] += v,
                 Slot::D(i, j) => self.d[(i, j)] += v,
             }
         }
@@ -458,9 +483,7 @@ impl Layout {
             let mut schur = self.d.clone();
             for i in 0..k {
                 for j in 0..k {
-                    let row = &self.c[i * ni..(i + 1) * ni];
-                    let col = &self.b[j * ni..(j + 1) * ni];
-                    schur[(i, j)] -= row.iter().zip(col).map(|(a, b)| a * b).sum::<f64>();
+                    schur[(i, j)] -= self.c_row_dot(i, &self.b[j * ni..(j + 1) * ni]);
                 }
             }
             let inverse = schur.partial_piv_lu().inverse();
@@ -479,9 +502,19 @@ impl Layout {
         Ok(())
     }
 
+    /// Row `b` of C times the interior vector `y`.
+    fn c_row_dot(&self, b: usize, y: &[f64]) -> f64 {
+        let range = self.c_ptr[b]..self.c_ptr[b + 1];
+        self.c_col[range.clone()]
+            .iter()
+            .zip(&self.c_val[range])
+            .map(|(&j, c)| c * y[j])
+            .sum()
+    }
+
     fn solve_cost(&self) -> SolveCost {
         let (k, ni) = (self.border.len(), self.interior.len());
-        SolveCost::of(&self.numeric, 2 * k * ni + k * k)
+        SolveCost::of(&self.numeric, k * ni + self.c_val.len() + k * k)
     }
 
     /// Overwrites `rhs` with S⁻¹ rhs (the last factorisation).
@@ -495,13 +528,7 @@ impl Layout {
         if k > 0 {
             // x_B = (D − C A⁻¹B)⁻¹ (r_B − C y), x_A = y − A⁻¹B x_B.
             for (b, &i) in self.border.iter().enumerate() {
-                let row = &self.c[b * ni..(b + 1) * ni];
-                // Four partial sums: a single one would chain every multiply-add.
-                let mut lanes = [0.0f64; 4];
-                for (lane, (a, y)) in (0..4).cycle().zip(row.iter().zip(&self.interior_rhs)) {
-                    lanes[lane] += a * y;
-                }
-                self.border_rhs[b] = rhs[i] - ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3]));
+                self.border_rhs[b] = rhs[i] - self.c_row_dot(b, &self.interior_rhs);
             }
             for (j, &i) in self.border.iter().enumerate() {
                 let x: f64 = self.schur_inverse[j * k..(j + 1) * k]
