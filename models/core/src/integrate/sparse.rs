@@ -676,14 +676,8 @@ mod tests {
     fn arrow_matrix_through_the_border_matches_dense_lu() {
         let n = 200;
         let dense_at = [57, 131];
-        let mut entries = Vec::new();
-        let mut values = Vec::new();
-        let mut full = Mat::<f64>::zeros(n, n);
-        let mut push = |r: usize, c: usize, v: f64| {
-            entries.push((r, c));
-            values.push(v);
-            full[(r, c)] += v;
-        };
+        let mut m = TestMatrix::new(n);
+        let mut push = |r: usize, c: usize, v: f64| m.push(r, c, v);
         for i in 0..n {
             push(i, i, 4.0 + (i % 7) as f64);
             if i + 1 < n {
@@ -699,11 +693,11 @@ mod tests {
                 }
             }
         }
-        let mut s = IterationMatrix::new(n, &entries).unwrap();
+        let mut s = IterationMatrix::new(n, &m.entries).unwrap();
         assert_eq!(s.border(), &dense_at);
-        s.factorise(&values).unwrap();
+        s.factorise(&m.values).unwrap();
         let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
-        for (i, (x, reference)) in solved_and_dense(&mut s, &full, &rhs)
+        for (i, (x, reference)) in solved_and_dense(&mut s, &m.full, &rhs)
             .into_iter()
             .enumerate()
         {
@@ -720,14 +714,8 @@ mod tests {
     fn loop_of_two_chains_is_swept_from_both_ends() {
         let m = 50;
         let (n, e) = (2 * m + 1, 2 * m);
-        let mut entries = Vec::new();
-        let mut values = Vec::new();
-        let mut full = Mat::<f64>::zeros(n, n);
-        let mut push = |r: usize, c: usize, v: f64| {
-            entries.push((r, c));
-            values.push(v);
-            full[(r, c)] += v;
-        };
+        let mut matrix = TestMatrix::new(n);
+        let mut push = |r: usize, c: usize, v: f64| matrix.push(r, c, v);
         for i in 0..n {
             push(i, i, 4.0 + (i % 5) as f64);
         }
@@ -747,14 +735,14 @@ mod tests {
             push(chain.start, e, 0.05);
             push(e, chain.start, 0.04);
         }
-        let mut s = IterationMatrix::with_coupled(n, &entries, &[e]).unwrap();
-        s.factorise(&values).unwrap();
+        let mut s = IterationMatrix::with_coupled(n, &matrix.entries, &[e]).unwrap();
+        s.factorise(&matrix.values).unwrap();
         // One front along the 2m-long chain would chain about 2 × 2m unknowns through the two
         // sweeps; two fronts side by side, about 2 × m.
         let cost = s.solve_cost();
         assert!(cost.chain <= 2 * m + 4, "{cost:?}");
         let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.53).sin()).collect();
-        for (i, (x, reference)) in solved_and_dense(&mut s, &full, &rhs)
+        for (i, (x, reference)) in solved_and_dense(&mut s, &matrix.full, &rhs)
             .into_iter()
             .enumerate()
         {
@@ -809,6 +797,30 @@ mod tests {
                 (x - reference).abs() < 1e-10 * (1.0 + reference.abs()),
                 "{i}: {x} vs {reference}"
             );
+        }
+    }
+
+    /// A test matrix entry by entry: the pattern and values as a system declares them
+    /// (duplicates allowed), and the same matrix dense for the reference LU.
+    struct TestMatrix {
+        entries: Vec<(usize, usize)>,
+        values: Vec<f64>,
+        full: Mat<f64>,
+    }
+
+    impl TestMatrix {
+        fn new(n: usize) -> Self {
+            Self {
+                entries: Vec::new(),
+                values: Vec::new(),
+                full: Mat::zeros(n, n),
+            }
+        }
+
+        fn push(&mut self, row: usize, col: usize, value: f64) {
+            self.entries.push((row, col));
+            self.values.push(value);
+            self.full[(row, col)] += value;
         }
     }
 
