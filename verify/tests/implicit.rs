@@ -118,10 +118,10 @@ proptest! {
 /// feedback of the effector's x into both reel rows closes the chains into a loop; with x in
 /// the border and the chain swept from both ends, the sweeps' critical path is ~n (two fronts of
 /// n/2 unknowns each) instead of COLAMD's ~2n (measured 162 against 318 for n = 162, and 1.2
-/// against 2.0 µs per solve), so the path must stay below 1.2 n. FE: the border-free layouts
-/// are cheapest (COLAMD's factors: 659 non-zeros over a 68-long path on the run's first matrix;
-/// with x in the border or in the other order 720–1620), and whichever is kept must not cost
-/// more than that.
+/// against 2.0 µs per solve), so the path must stay below 1.2 n. FE: the coupled border does not
+/// pay (its l_i already tie the chain together; on this test's matrix, q'' = 0 at t = h, the
+/// border-free layouts estimate 607–659 against 720–1070 with x in the border), so the kept
+/// layout has none.
 #[test]
 fn paper_iteration_matrices_keep_the_cheapest_layout() {
     use cdpr_core::closed_loop::ClosedLoop;
@@ -148,7 +148,7 @@ fn paper_iteration_matrices_keep_the_cheapest_layout() {
                 assert_eq!(matrix.border(), coupled.as_slice());
                 assert!(10 * cost.chain < 12 * n, "{cost:?}");
             }
-            _ => assert!(cost.estimate() <= 660, "{cost:?}"),
+            _ => assert!(matrix.border().is_empty(), "{cost:?}"),
         }
     }
 }
@@ -245,8 +245,10 @@ fn implicit_paper_runs_meet_section_8_and_track_dormand_prince() {
         // matrix costs have paid for a refresh (rent-or-buy). FE's fresh matrix converges in one
         // iteration for hundreds of steps (measured 1.05 iterations per step, a refresh per 590
         // steps); the lumped one ages within a step, its first free nodes being 0.2–0.5 mm from
-        // the pulleys (measured 2.17 iterations per step, a refresh per 17 steps). The bounds
-        // leave ~5–10 % for refresh timings, which move with the last bits of the trajectory.
+        // the pulleys (measured 2.17 iterations per step, a refresh per 17 steps). The bounds on
+        // iterations leave 5 % (FE) and 10 % (lumped) for refresh timings, which move with the
+        // last bits of the trajectory; those on steps per refresh are looser (100 against 590,
+        // 10 against 17): they catch a refresh rule gone wild, not its tuning.
         let iterations = s.newton_iterations as f64 / s.steps_accepted as f64;
         let (most_iterations, fewest_steps_per_refresh) = match run.kind {
             ModelKind::Lumped => (2.4, 10),

@@ -174,6 +174,10 @@ pub fn terms_damped(
     s: &ElementState,
     damping: f64,
 ) -> ElementTerms {
+    debug_assert!(
+        (s.h * s.inv_h - 1.0).abs() < 1e-12,
+        "inv_h out of step with h"
+    );
     let mu = mat.mu;
     let (h, ld) = (s.h, s.l_rate);
     let (a, b) = (s.va, s.vb);

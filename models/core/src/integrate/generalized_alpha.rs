@@ -263,15 +263,16 @@ impl GeneralizedAlpha {
     }
 
     /// Whether to re-evaluate S before this step although it converges: once the iterations a
-    /// stale S has cost beyond one per step reach what the refresh cost in residual evaluations
-    /// (an iteration costs a residual and a solve, a refresh its evaluations and a factorisation),
-    /// a refresh has paid for itself. The rent-or-buy rule: never more than twice the work of the
-    /// best refresh schedule in hindsight. Paper runs: FE N = 10, whose fresh matrix converges in
-    /// one iteration for hundreds of steps, 1.05 iterations per step with 85 refreshes (1.46 with
-    /// 23 when refreshing only on slow contraction); lumped N = 40, whose matrix ages within a
-    /// step (its first free nodes sit 0.2–0.5 mm from the pulleys, transverse stiffness T/d, and
-    /// the near-horizontal springs' vertical stiffness ≈ k φ² follows the string vibrations),
-    /// 2.17 iterations per step with a refresh every ~18 steps (2.66 and every ~27).
+    /// stale S has cost beyond one per step reach what the last refresh cost in residual
+    /// evaluations. A rent-or-buy heuristic: an iteration costs a residual and a solve, a refresh
+    /// its evaluations and a factorisation, and the counts stand in for both (no guarantee where a
+    /// fresh S itself needs more than one iteration, or where the factorisation dominates).
+    /// Paper runs: FE N = 10, whose fresh matrix converges in one iteration for hundreds of
+    /// steps, 1.05 iterations per step with 85 refreshes (1.46 with 23 when refreshing only on
+    /// slow contraction; 0.216 → 0.184 s); lumped N = 40, whose matrix ages within a step (its
+    /// first free nodes sit 0.2–0.5 mm from the pulleys, transverse stiffness T/d, and the
+    /// near-horizontal springs' vertical stiffness ≈ k φ² follows the string vibrations), 2.17
+    /// iterations per step with a refresh every ~17 steps (2.66 and every ~27; same wall time).
     fn refresh_pays(&self) -> bool {
         self.refresh_evals > 0 && self.excess_iterations >= self.refresh_evals
     }

@@ -1,9 +1,10 @@
 //! The Newton iteration matrix of the implicit integrator as a faer sparse LU (MODELS.md §6, FE.9.3).
 //!
 //! As in faer itself, the symbolic and the numeric work are kept apart: the pattern the model
-//! declares is analysed once ([`IterationMatrix::new`]: compressed columns, fill-reducing ordering,
-//! symbolic LU), and each refactorisation only recomputes the numbers into memory allocated then, so
-//! the time-stepping loop allocates nothing.
+//! declares is analysed once ([`IterationMatrix::new`]: border split, compressed columns,
+//! fill-reducing ordering), and each refactorisation only recomputes the numbers into memory
+//! allocated then, so the Newton solves allocate nothing (a refactorisation with a border
+//! allocates its k × k Schur complement and inverse, k ≤ 4 here).
 //!
 //! Dense rows and columns (the FE model's l_i couple to every node of their span) are split off as
 //! a border and eliminated by a Schur complement, S = [A B; C D]: the sparse LU factorises only A,
@@ -210,8 +211,9 @@ fn two_front(order: &[usize]) -> Perm<usize> {
 
 impl IterationMatrix {
     /// Analyses the pattern `entries` (row, col) of an n × n matrix: the border (unknowns whose row
-    /// or column holds more than max(32, 4 × the mean) entries), then the symbolic factorisation
-    /// of the interior in both candidate column orders, done once per pattern.
+    /// or column holds more than max(32, 4 × the mean) entries), the interior's compressed
+    /// columns and faer's COLAMD order, and from it the two candidate column orders, done once
+    /// per pattern (the factors' structure appears at the first numeric factorisation).
     pub fn new(n: usize, entries: &[(usize, usize)]) -> Result<Self, SparseError> {
         Self::with_coupled(n, entries, &[])
     }
@@ -244,20 +246,30 @@ impl IterationMatrix {
             .map(|i| per_row[i].max(per_col[i]) > dense_limit)
             .collect();
         let mut splits = vec![dense.clone()];
-        if coupled.iter().any(|&i| !dense[i]) {
-            let mut with_coupled = dense;
-            for &i in coupled {
-                with_coupled[i] = true;
-            }
+        let mut with_coupled = dense;
+        for &i in coupled {
+            with_coupled[i] = true;
+        }
+        // Only a split that adds border unknowns and leaves an interior is a new candidate.
+        if with_coupled != splits[0] && with_coupled.iter().any(|&border| !border) {
             splits.push(with_coupled);
         }
         let mut candidates = Vec::new();
+        let mut first_error = None;
         for is_border in &splits {
             for order in [Order::Colamd, Order::TwoFront] {
-                candidates.push(Layout::new(n, entries, &cells, is_border, order)?);
+                match Layout::new(n, entries, &cells, is_border, order) {
+                    Ok(layout) => candidates.push(layout),
+                    Err(e) => {
+                        first_error.get_or_insert(e);
+                    }
+                }
             }
         }
-        Ok(Self { candidates })
+        match first_error {
+            Some(e) if candidates.is_empty() => Err(e),
+            _ => Ok(Self { candidates }),
+        }
     }
 
     /// The layout in use (the first candidate until the first factorisation has chosen).
@@ -288,8 +300,10 @@ impl IterationMatrix {
 
     /// Sets S from `entry_values`, given in the order of the pattern passed to [`Self::new`]
     /// (duplicates are summed), and factorises it numerically. The first call factorises every
-    /// candidate layout and keeps the one with the cheapest [`SolveCost`] (ties: the first, with
-    /// COLAMD's order and the fewest border unknowns); a layout that fails is dropped unless all do.
+    /// candidate layout and keeps the one with the cheapest [`SolveCost`] (ties: the earlier in
+    /// the order dense-only border before coupled, COLAMD before two fronts); a layout that fails
+    /// is dropped unless all do. A singular interior or Schur complement is an error (the caller
+    /// decides whether a shorter step helps).
     pub fn factorise(&mut self, entry_values: &[f64]) -> Result<(), SparseError> {
         if self.candidates.len() == 1 {
             return self.candidates[0].factorise(entry_values);
@@ -835,6 +849,29 @@ mod tests {
             .enumerate()
             .map(|(i, x)| (x, reference[(i, 0)]))
             .collect()
+    }
+
+    /// Tiny systems whose coupled unknowns would leave no interior keep the border-free layout
+    /// and still solve (no empty interior reaches the Schur step).
+    #[test]
+    fn coupled_unknowns_never_empty_the_interior() {
+        for (n, coupled) in [(1, vec![0]), (2, vec![0, 1]), (2, vec![1])] {
+            let mut m = TestMatrix::new(n);
+            for i in 0..n {
+                m.push(i, i, 3.0 + i as f64);
+                if i + 1 < n {
+                    m.push(i, i + 1, 1.0);
+                    m.push(i + 1, i, -0.5);
+                }
+            }
+            let mut s = IterationMatrix::with_coupled(n, &m.entries, &coupled).unwrap();
+            s.factorise(&m.values).unwrap();
+            assert!(s.border().len() < n, "n = {n}: border {:?}", s.border());
+            let rhs: Vec<f64> = (0..n).map(|i| 1.0 + i as f64).collect();
+            for (x, reference) in solved_and_dense(&mut s, &m.full, &rhs) {
+                assert!((x - reference).abs() < 1e-14, "n = {n}: {x} vs {reference}");
+            }
+        }
     }
 
     #[test]
