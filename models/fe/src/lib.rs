@@ -33,6 +33,36 @@ use solve::ChainSystem;
 /// Direction from each pulley towards its reel, e_out,i (MODELS.md FE.2).
 pub const E_OUT: [f64; 2] = [-1.0, 1.0];
 
+/// What the N free elements of a span share: l' [m/s], h = l_i/N [m], 1/h [1/m] and h' = 1/N.
+#[derive(Debug, Clone, Copy)]
+struct Span {
+    l_rate: f64,
+    h: f64,
+    inv_h: f64,
+    h_prime: f64,
+}
+
+impl Span {
+    /// The element between nodes (r_a, v_a) and (r_b, v_b) of this span.
+    #[inline]
+    fn element(
+        &self,
+        (ra, va): (Vector2<f64>, Vector2<f64>),
+        (rb, vb): (Vector2<f64>, Vector2<f64>),
+    ) -> ElementState {
+        ElementState {
+            ra,
+            rb,
+            va,
+            vb,
+            l_rate: self.l_rate,
+            h: self.h,
+            inv_h: self.inv_h,
+            h_prime: self.h_prime,
+        }
+    }
+}
+
 /// The two-cable robot with variable-length FE cables.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Fe {
@@ -191,31 +221,25 @@ impl Fe {
         }
     }
 
-    /// The span's element length h = l_i/N, its inverse and h' = 1/N [m, 1/m, –]: computed once
-    /// per span, since all N free elements share them.
+    /// What the free elements of `cable`'s span share, computed once per span.
     #[inline]
-    fn span_length(&self, y: &[f64], cable: usize) -> (f64, f64, f64) {
+    fn span_of(&self, y: &[f64], cable: usize) -> Span {
         let n = self.elements as f64;
-        let h = y[self.l_index(cable)] / n;
-        (h, 1.0 / h, 1.0 / n)
+        let li = self.l_index(cable);
+        let h = y[li] / n;
+        Span {
+            l_rate: y[self.positions_len() + li],
+            h,
+            inv_h: 1.0 / h,
+            h_prime: 1.0 / n,
+        }
     }
 
     /// State of element e (1…N) of `cable`.
     #[inline]
     fn free_element(&self, y: &[f64], cable: usize, e: usize) -> ElementState {
-        let l_rate = y[self.positions_len() + self.l_index(cable)];
-        let (h, inv_h, h_prime) = self.span_length(y, cable);
-        let ((ra, va), (rb, vb)) = (self.node(y, cable, e - 1), self.node(y, cable, e));
-        ElementState {
-            ra,
-            rb,
-            va,
-            vb,
-            l_rate,
-            h,
-            inv_h,
-            h_prime,
-        }
+        self.span_of(y, cable)
+            .element(self.node(y, cable, e - 1), self.node(y, cable, e))
     }
 
     /// The N elements of `cable`'s span in order e = 1 (at the pulley) … N (at the effector),
@@ -223,21 +247,11 @@ impl Fe {
     /// re-deriving each node's index and the span's h per element.
     #[inline]
     fn span<'a>(&'a self, y: &'a [f64], cable: usize) -> impl Iterator<Item = ElementState> + 'a {
-        let l_rate = y[self.positions_len() + self.l_index(cable)];
-        let (h, inv_h, h_prime) = self.span_length(y, cable);
+        let span = self.span_of(y, cable);
         let mut a = self.node(y, cable, 0);
         (1..=self.elements).map(move |e| {
             let b = self.node(y, cable, e);
-            let s = ElementState {
-                ra: a.0,
-                rb: b.0,
-                va: a.1,
-                vb: b.1,
-                l_rate,
-                h,
-                inv_h,
-                h_prime,
-            };
+            let s = span.element(a, b);
             a = b;
             s
         })

@@ -189,10 +189,10 @@ impl AlphaCoefficients {
     }
 }
 
-/// How one Newton solve ended.
+/// How one Newton solve ended (converged: after how many iterations).
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Newton {
-    Converged,
+    Converged(u64),
     Slow,
     NonFinite(usize),
 }
@@ -227,8 +227,6 @@ pub struct GeneralizedAlpha {
     /// since (the refresh rule of [`Self::refresh_pays`]).
     refresh_evals: u64,
     excess_iterations: u64,
-    /// Newton iterations of the step's last Newton solve.
-    step_iterations: u64,
     stats: SolverStats,
 }
 
@@ -257,7 +255,6 @@ impl GeneralizedAlpha {
             matrix_h: 0.0,
             refresh_evals: 0,
             excess_iterations: 0,
-            step_iterations: 0,
             stats: SolverStats::default(),
         }
     }
@@ -382,8 +379,7 @@ impl GeneralizedAlpha {
             self.opts.slow_contraction
         };
         let mut previous = f64::INFINITY;
-        self.step_iterations = 0;
-        for _ in 0..=self.opts.max_iterations {
+        for iterations in 0..=self.opts.max_iterations as u64 {
             self.kinematics(h);
             sys.residual(t, &self.y_try, &self.qdd_try, &mut self.r);
             self.stats.rhs_evals += 1;
@@ -397,7 +393,7 @@ impl GeneralizedAlpha {
             // Fine stiff meshes cannot go below their round-off (lumped N = 1000 stalls at
             // 1.0–1.3e-7 N against 1e-7 N): `tol` accounts for it.
             if norm <= tol {
-                return Newton::Converged;
+                return Newton::Converged(iterations);
             }
             if norm > limit * previous {
                 return Newton::Slow;
@@ -411,7 +407,6 @@ impl GeneralizedAlpha {
                 *q -= d;
             }
             self.stats.newton_iterations += 1;
-            self.step_iterations += 1;
         }
         Newton::Slow
     }
@@ -537,8 +532,8 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
                 outcome = self.newton(sys, t1, h, true, tol);
             }
             self.stats.steps_attempted += 1;
-            match outcome {
-                Newton::Converged => {}
+            let iterations = match outcome {
+                Newton::Converged(iterations) => iterations,
                 failed => {
                     self.stats.steps_rejected += 1;
                     self.successes = 0;
@@ -557,7 +552,7 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
                     }
                     continue;
                 }
-            }
+            };
             self.y_prev.copy_from_slice(&self.y);
             self.dy_prev.copy_from_slice(&self.dy);
             self.y[..2 * n].copy_from_slice(&self.y_try[..2 * n]);
@@ -573,7 +568,7 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
             rest[..n].copy_from_slice(&self.qdd);
             sys.tail_rate(self.t, &self.y, &mut rest[n..]);
             self.stats.steps_accepted += 1;
-            self.excess_iterations += self.step_iterations.saturating_sub(1);
+            self.excess_iterations += iterations.saturating_sub(1);
             if self.h < self.opts.step {
                 self.successes += 1;
                 if self.successes >= SUCCESSES_BEFORE_GROWTH {

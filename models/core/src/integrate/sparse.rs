@@ -73,13 +73,6 @@ pub struct IterationMatrix {
     candidates: Vec<Layout>,
 }
 
-/// Which column order the interior's LU uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Order {
-    Colamd,
-    TwoFront,
-}
-
 /// One layout of S (n × n): a border split, the interior block A as a compressed-column matrix
 /// in one column order with its numeric LU, and the dense border.
 struct Layout {
@@ -257,12 +250,10 @@ impl IterationMatrix {
         let mut candidates = Vec::new();
         let mut first_error = None;
         for is_border in &splits {
-            for order in [Order::Colamd, Order::TwoFront] {
-                match Layout::new(n, entries, &cells, is_border, order) {
-                    Ok(layout) => candidates.push(layout),
-                    Err(e) => {
-                        first_error.get_or_insert(e);
-                    }
+            match Layout::for_split(n, entries, &cells, is_border) {
+                Ok(layouts) => candidates.extend(layouts),
+                Err(e) => {
+                    first_error.get_or_insert(e);
                 }
             }
         }
@@ -325,8 +316,8 @@ impl IterationMatrix {
         }
         match best {
             Some((_, i)) => {
-                let chosen = self.candidates.swap_remove(i);
-                self.candidates = vec![chosen];
+                self.candidates.swap(0, i);
+                self.candidates.truncate(1);
                 Ok(())
             }
             None => Err(first_error.unwrap_or(SparseError::Factorisation("no layout".into()))),
@@ -340,16 +331,16 @@ impl IterationMatrix {
 }
 
 impl Layout {
-    /// The symbolic work for one layout: the border split, the compressed columns of the
-    /// interior (`cells`: the pattern as sorted, deduplicated (col, row) with the diagonal) and
-    /// its column order.
-    fn new(
+    /// The symbolic work for one border split: the compressed columns of the interior (`cells`:
+    /// the pattern as sorted, deduplicated (col, row) with the diagonal) and faer's COLAMD order,
+    /// done once; then a layout per candidate column order (COLAMD's, and the two-front one
+    /// where it differs).
+    fn for_split(
         n: usize,
         entries: &[(usize, usize)],
         cells: &[(usize, usize)],
         is_border: &[bool],
-        order: Order,
-    ) -> Result<Self, SparseError> {
+    ) -> Result<Vec<Self>, SparseError> {
         let border: Vec<usize> = (0..n).filter(|&i| is_border[i]).collect();
         let interior: Vec<usize> = (0..n).filter(|&i| !is_border[i]).collect();
         // Local index of each global unknown within its part.
@@ -391,7 +382,7 @@ impl Layout {
             c_ptr[r + 1] += c_ptr[r];
         }
         let c_col: Vec<usize> = c_cells.iter().map(|&(_, c)| c).collect();
-        let slot = entries
+        let slot: Vec<Slot> = entries
             .iter()
             .map(|&(r, c)| match (is_border[r], is_border[c]) {
                 (false, false) => {
@@ -416,37 +407,39 @@ impl Layout {
         let symbolic = lu::factorize_symbolic_lu(pattern.as_ref(), Default::default())
             .map_err(|e| SparseError::Factorisation(format!("{e:?}")))?;
         let (forward, inverse) = symbolic.col_perm().arrays();
-        let col_perm = match order {
-            Order::Colamd => Perm::new_checked(forward.into(), inverse.into(), ni),
-            Order::TwoFront => two_front(forward),
-        };
-        let factor_memory = MemBuffer::new(simplicial::factorize_simplicial_numeric_lu_scratch::<
-            usize,
-            f64,
-        >(ni, ni));
-        Ok(Self {
-            n,
-            interior,
-            border,
-            pattern,
-            slot,
-            values: vec![0.0; nnz],
-            b: vec![0.0; ni * k],
-            c_val: vec![0.0; c_col.len()],
-            c_ptr,
-            c_col,
-            d: Mat::zeros(k, k),
-            schur_inverse: vec![0.0; k * k],
-            col_perm,
-            numeric: SimplicialLu::new(),
-            row_perm: vec![0; ni],
-            row_perm_inv: vec![0; ni],
-            factor_memory,
-            substitution: Substitution::default(),
-            factorised: false,
-            interior_rhs: vec![0.0; ni],
-            border_rhs: vec![0.0; k],
-        })
+        let mut orders = vec![Perm::new_checked(forward.into(), inverse.into(), ni)];
+        let both_ends = two_front(forward);
+        if both_ends.as_ref().arrays().0 != forward {
+            orders.push(both_ends);
+        }
+        Ok(orders
+            .into_iter()
+            .map(|col_perm| Self {
+                n,
+                interior: interior.clone(),
+                border: border.clone(),
+                pattern: pattern.clone(),
+                slot: slot.clone(),
+                values: vec![0.0; nnz],
+                b: vec![0.0; ni * k],
+                c_val: vec![0.0; c_col.len()],
+                c_ptr: c_ptr.clone(),
+                c_col: c_col.clone(),
+                d: Mat::zeros(k, k),
+                schur_inverse: vec![0.0; k * k],
+                col_perm,
+                numeric: SimplicialLu::new(),
+                row_perm: vec![0; ni],
+                row_perm_inv: vec![0; ni],
+                factor_memory: MemBuffer::new(
+                    simplicial::factorize_simplicial_numeric_lu_scratch::<usize, f64>(ni, ni),
+                ),
+                substitution: Substitution::default(),
+                factorised: false,
+                interior_rhs: vec![0.0; ni],
+                border_rhs: vec![0.0; k],
+            })
+            .collect())
     }
 
     /// S from `entry_values` (pattern order, duplicates summed), factorised.
