@@ -64,7 +64,7 @@ pub fn run(scenario: Option<&Path>, model: Option<&str>, out: &Path, every: usiz
         },
     )?;
     println!(
-        "{}: {} samples, {} RHS evaluations, {} accepted / {} rejected steps, {} Newton iterations, {} matrix evaluations, {} factorisations, {} events, {:.3} s wall → {}",
+        "{}: {} samples, {} RHS evaluations, {} accepted / {} rejected steps, {} Newton iterations, {} matrix evaluations, {} factorisations ({} pivoting), {} events, {:.3} s wall → {}",
         run.model,
         run.series.len(),
         run.stats.rhs_evals,
@@ -73,6 +73,7 @@ pub fn run(scenario: Option<&Path>, model: Option<&str>, out: &Path, every: usiz
         run.stats.newton_iterations,
         run.stats.jacobian_evals,
         run.stats.factorisations,
+        run.stats.pivotings,
         run.events.len(),
         run.wall_s,
         out.display()

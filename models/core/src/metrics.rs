@@ -87,11 +87,12 @@ pub struct Metrics {
     pub rhs_evals: u64,
     pub steps_accepted: u64,
     pub steps_rejected: u64,
-    /// Implicit path only (0 for DOPRI5): Newton iterations, iteration-matrix evaluations and
-    /// numeric LU factorisations.
+    /// Implicit path only (0 for DOPRI5): Newton iterations, iteration-matrix evaluations,
+    /// numeric LU factorisations and those of them that pivoted afresh.
     pub newton_iterations: u64,
     pub jacobian_evals: u64,
     pub factorisations: u64,
+    pub pivotings: u64,
     pub wall_s: f64,
 }
 
@@ -251,6 +252,7 @@ impl Metrics {
             newton_iterations: run.stats.newton_iterations,
             jacobian_evals: run.stats.jacobian_evals,
             factorisations: run.stats.factorisations,
+            pivotings: run.stats.pivotings,
             wall_s: run.wall_s,
         }
     }

@@ -358,6 +358,7 @@ impl GeneralizedAlpha {
             .ok_or(IntegratorError::Usage("step before start"))?;
         matrix.factorise(&self.values)?;
         self.stats.factorisations += 1;
+        self.stats.pivotings = matrix.pivotings();
         self.matrix_h = h;
         Ok(())
     }

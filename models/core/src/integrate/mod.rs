@@ -43,6 +43,9 @@ pub struct SolverStats {
     pub jacobian_evals: u64,
     /// Numeric LU factorisations of the iteration matrix (implicit methods).
     pub factorisations: u64,
+    /// Of those, the ones that chose their pivots afresh (faer's LU with partial pivoting); the
+    /// others reused the last pivot sequence (see `IterationMatrix::pivotings`).
+    pub pivotings: u64,
 }
 
 /// One-step-at-a-time driving of an integrator on system `S`: what the runner needs for sampling
