@@ -94,6 +94,9 @@ pub struct ColouredDifferences {
     steps: Vec<f64>,
     /// Per coordinate, the largest step over which its forces are smooth (∞: no limit).
     step_limits: Vec<f64>,
+    /// ∂R/∂q'' when it is a constant diagonal (a lumped mass), with each diagonal entry's index
+    /// into the pattern: then it is written, not differenced.
+    diagonal_mass: Option<Vec<(usize, f64)>>,
 }
 
 /// R(state, q'') into the last argument, at fixed tensions.
@@ -155,7 +158,29 @@ impl ColouredDifferences {
             qdd: vec![0.0; n],
             steps: vec![0.0; n],
             step_limits: vec![f64::INFINITY; n],
+            diagonal_mass: None,
         }
+    }
+
+    /// Declares ∂R/∂q'' = diag(`mass`) (n entries, constant: R = diag(m) q'' − F(q, q')), so that
+    /// [`Self::fill`] writes it instead of spending a residual per column group on it (R is
+    /// linear in q'', so the difference would only reproduce m to round-off). Every (i, i) must
+    /// be in the pattern.
+    pub fn with_diagonal_mass(mut self, mass: &[f64]) -> Self {
+        assert_eq!(mass.len(), self.n, "one mass per coordinate");
+        let entries = mass
+            .iter()
+            .enumerate()
+            .map(|(i, &m)| {
+                let (_, k) = self.column_entries[i]
+                    .iter()
+                    .find(|&&(r, _)| r == i)
+                    .expect("the pattern holds the diagonal");
+                (*k, m)
+            })
+            .collect();
+        self.diagonal_mass = Some(entries);
+        self
     }
 
     /// Per coordinate q_j, the largest step [m] over which the forces are smooth in q_j (a
@@ -222,10 +247,23 @@ impl ColouredDifferences {
         values.fill(0.0);
         self.state.copy_from_slice(&state[..2 * n]);
         self.qdd.copy_from_slice(qdd);
-        residual(&self.state, &self.qdd, &mut self.base);
-        let mut evals = 1;
-        // Derivative 0: q'' (weight 1), 1: q' (c_v), 2: q (c_q).
-        for (derivative, weight) in [(0usize, 1.0), (1, c_v), (2, c_q)] {
+        let mut evals = 0;
+        let q_dd_weight = match &self.diagonal_mass {
+            Some(mass) => {
+                for &(k, m) in mass {
+                    values[k] = m;
+                }
+                0.0
+            }
+            None => {
+                // The base of the q'' forward difference.
+                residual(&self.state, &self.qdd, &mut self.base);
+                evals += 1;
+                1.0
+            }
+        };
+        // Derivative 0: q'' (weight 1), 1: q' (c_v), 2: q (c_q); a zero weight is skipped.
+        for (derivative, weight) in [(0usize, q_dd_weight), (1, c_v), (2, c_q)] {
             if weight == 0.0 {
                 continue;
             }

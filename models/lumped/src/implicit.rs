@@ -1,8 +1,8 @@
 //! The lumped model's second-order form for the implicit integrator (MODELS.md §6):
 //! R = diag(m) q'' − F(q, q', T), with F the spring, gravity and reel forces of [`Lumped::forces`]
 //! (a stored node's vertical force is the constraint's business: its row reads m z'' = 0, so it
-//! stays on z = 0 exactly). The iteration matrix comes from coloured finite differences over the
-//! chain's pattern: every node couples only to its two neighbours along its cable (the straddling
+//! stays on z = 0 exactly). The iteration matrix is diag(m), written exactly, plus coloured
+//! finite differences of F over the chain's pattern: every node couples only to its two neighbours along its cable (the straddling
 //! spring included: its ends are neighbours too), the effector to the last node of each cable.
 //! The pattern does not depend on which nodes are stored, so pulley events never change it.
 
@@ -130,9 +130,17 @@ impl SecondOrderForm for Lumped {
     ) -> u64 {
         let mut differences = match self.implicit.differences.take() {
             Some(d) => d,
-            None => ColouredDifferences::new(self.dofs(), &self.iteration_pattern()),
+            None => {
+                let mut mass = vec![self.node_mass; self.dofs()];
+                mass[4 * self.elements..].fill(self.effector_mass);
+                ColouredDifferences::new(self.dofs(), &self.iteration_pattern())
+                    .with_diagonal_mass(&mass)
+            }
         };
         self.smooth_reach(state, differences.step_limits_mut());
+        // Undamped springs (the paper's run) pull with forces of the positions alone: ∂R/∂q' = 0,
+        // and differencing it would cost two residuals per column group for zeros.
+        let c_v = if self.damping == 0.0 { 0.0 } else { c_v };
         let evals = differences.fill(
             &mut |s, a, r| self.residual_into(s, a, tensions, r),
             state,

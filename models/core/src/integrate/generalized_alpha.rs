@@ -268,8 +268,12 @@ impl GeneralizedAlpha {
     /// steps, 1.05 iterations per step with 85 refreshes (1.46 with 23 when refreshing only on
     /// slow contraction; 0.216 → 0.184 s); lumped N = 40, whose matrix ages within a step (its
     /// first free nodes sit 0.2–0.5 mm from the pulleys, transverse stiffness T/d, and the
-    /// near-horizontal springs' vertical stiffness ≈ k φ² follows the string vibrations), 2.17
-    /// iterations per step with a refresh every ~17 steps (2.66 and every ~27; same wall time).
+    /// near-horizontal springs' vertical stiffness ≈ k φ² follows the string vibrations), 2.11
+    /// iterations per step with a refresh (18 residual evaluations) every ~11 steps (2.66 and
+    /// every ~27 before the rule). Refreshing every step would not make it one: a fresh lumped
+    /// matrix still needs 1.22 iterations per step, and one whose entries are refreshed only
+    /// where they moved by more than 1e-6 relative needs 1.96 (the matrix is ill-conditioned
+    /// enough, effector and node masses 400 apart, that tiny drifts everywhere matter).
     fn refresh_pays(&self) -> bool {
         self.refresh_evals > 0 && self.excess_iterations >= self.refresh_evals
     }
