@@ -272,8 +272,8 @@ impl GeneralizedAlpha {
     /// iterations per step with a refresh (18 residual evaluations) every ~11 steps (2.66 and
     /// every ~27 before the rule). Refreshing every step would not make it one: a fresh lumped
     /// matrix still needs 1.22 iterations per step, and one whose entries are refreshed only
-    /// where they moved by more than 1e-6 relative needs 1.96 (the matrix is ill-conditioned
-    /// enough, effector and node masses 400 apart, that tiny drifts everywhere matter).
+    /// where they moved by more than 1e-6 relative needs 1.96: many small drifts matter, not a
+    /// few large ones, so no local update of the matrix would do.
     fn refresh_pays(&self) -> bool {
         self.refresh_evals > 0 && self.excess_iterations >= self.refresh_evals
     }
