@@ -43,10 +43,32 @@ pub(crate) fn event_functions(model: &Lumped, y: &[f64], out: &mut [f64]) {
         } else {
             1.0
         };
-        let stored_watch = (0..r.saturating_sub(1)).map(|j| beyond(model, y, cable, j));
-        let free_watch = (r + 1..n).map(|j| -beyond(model, y, cable, j));
-        g[2] = stored_watch.chain(free_watch).fold(1.0, f64::min);
+        // Over the cable's contiguous x: stored nodes but the last, free nodes but the first.
+        let start = model.xi(cable, 0);
+        let x = &y[start..start + n];
+        let (a, e) = (model.pulley(cable).x, E_OUT[cable]);
+        let stored_watch = smallest(&x[..r.saturating_sub(1)], |xj| (xj - a) * e);
+        let free_watch = smallest(&x[(r + 1).min(n)..], |xj| -((xj - a) * e));
+        g[2] = stored_watch.min(free_watch).min(1.0);
     }
+}
+
+/// min over `x` of `f` (∞ for none), in four independent lanes: a sequential min is a chain of
+/// dependent instructions, and this runs at every step. A min is exact, so the lanes change no
+/// bit of the result.
+fn smallest(x: &[f64], f: impl Fn(f64) -> f64) -> f64 {
+    let mut lanes = [f64::INFINITY; 4];
+    let chunks = x.chunks_exact(4);
+    let tail = chunks
+        .remainder()
+        .iter()
+        .fold(f64::INFINITY, |m, &v| m.min(f(v)));
+    for chunk in chunks {
+        for (m, &v) in lanes.iter_mut().zip(chunk) {
+            *m = m.min(f(v));
+        }
+    }
+    lanes.into_iter().fold(tail, f64::min)
 }
 
 /// Applies event `index` at `t` (see the module documentation).
