@@ -460,8 +460,12 @@ fn write_markdown(
         for o in outcomes {
             writeln!(
                 w,
-                "| {} | {:.7} | {:.6} | {:.7} | {:.6} |",
-                o.kind, o.metrics.z0, o.metrics.f0, o.end.effector.y, o.end.equilibrium.force
+                "| {} | {} | {} | {} | {} |",
+                o.kind,
+                fixed(o.metrics.z0, 7),
+                fixed(o.metrics.f0, 6),
+                fixed(o.end.effector.y, 7),
+                fixed(o.end.equilibrium.force, 6)
             )?;
         }
 
@@ -517,4 +521,29 @@ fn write_markdown(
         )?;
         Ok(())
     })
+}
+
+/// `v` with `decimals` decimals, without the sign of a value that rounds to zero (the static
+/// F0 at the symmetric x = 0.5 is ±1e-12 N of round-off, which would print as "-0.000000").
+fn fixed(v: f64, decimals: usize) -> String {
+    let text = format!("{v:.decimals$}");
+    match text.strip_prefix('-') {
+        Some(magnitude) if magnitude.chars().all(|c| c == '0' || c == '.') => magnitude.to_string(),
+        _ => text,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fixed;
+
+    #[test]
+    fn fixed_drops_the_sign_of_a_rounded_zero_only() {
+        assert_eq!(fixed(-1e-12, 6), "0.000000");
+        assert_eq!(fixed(-0.0, 3), "0.000");
+        assert_eq!(fixed(-0.0237291, 7), "-0.0237291");
+        assert_eq!(fixed(0.097531, 6), "0.097531");
+        assert_eq!(fixed(-4e-7, 6), "0.000000");
+        assert_eq!(fixed(-6e-7, 6), "-0.000001");
+    }
 }
