@@ -617,6 +617,9 @@ struct Factors {
     /// Scratch of the refactorisation (all zero between columns) and of the triangular solves.
     work: Vec<f64>,
     x: Vec<f64>,
+    /// Scratch for sorting a column of U when adopting faer's factors (a column can be long: a
+    /// layout without the coupled border has the effector's x column across the chain).
+    sort_scratch: Vec<(usize, f64)>,
 }
 
 impl Factors {
@@ -668,15 +671,14 @@ impl Factors {
             let last = u_ptr[j + 1] - 1;
             self.u_row.extend_from_slice(&u_row[u_ptr[j]..last]);
             self.u_val.extend_from_slice(&u_val[u_ptr[j]..last]);
-            // Insertion sort: a column holds a handful of entries.
             let (rows, vals) = (&mut self.u_row[start..], &mut self.u_val[start..]);
-            for a in 1..rows.len() {
-                let mut b = a;
-                while b > 0 && rows[b - 1] > rows[b] {
-                    rows.swap(b - 1, b);
-                    vals.swap(b - 1, b);
-                    b -= 1;
-                }
+            self.sort_scratch.clear();
+            self.sort_scratch
+                .extend(rows.iter().copied().zip(vals.iter().copied()));
+            self.sort_scratch.sort_unstable_by_key(|&(r, _)| r);
+            for ((r, v), &(sr, sv)) in rows.iter_mut().zip(vals.iter_mut()).zip(&self.sort_scratch)
+            {
+                (*r, *v) = (sr, sv);
             }
             self.u_row.push(j);
             self.u_val.push(u_val[last]);
