@@ -456,5 +456,14 @@ mod tests {
                 values[idx]
             );
         }
+        // The same with the mass declared: no q'' probes, and the same matrix to the q''
+        // difference's round-off (ε·max(1, |q''|)·|R| / step ≈ 1e-12 here).
+        let mut declared = ColouredDifferences::new(n, &pattern).with_diagonal_mass(&vec![m; n]);
+        let mut exact_mass = vec![0.0; pattern.len()];
+        let evals = declared.fill(&mut f, &state, &qdd, c_v, c_q, &mut exact_mass);
+        assert_eq!(evals, 2 * 3 * 2, "q' and q central only");
+        for (idx, (a, b)) in exact_mass.iter().zip(&values).enumerate() {
+            assert!((a - b).abs() <= 1e-9 * m, "entry {idx}: {a} vs {b}");
+        }
     }
 }
