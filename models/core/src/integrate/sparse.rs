@@ -921,23 +921,9 @@ mod tests {
     #[test]
     fn pivoted_banded_system_matches_dense_lu() {
         let n = 60;
-        let mut entries = Vec::new();
-        let mut values = Vec::new();
-        let mut full = Mat::<f64>::zeros(n, n);
-        for i in 0..n {
-            for j in i.saturating_sub(3)..(i + 4).min(n) {
-                let v = if i == j {
-                    1e-3 * (1.0 + (i % 5) as f64)
-                } else {
-                    ((7 * i + 3 * j) as f64 * 0.61).sin()
-                };
-                entries.push((i, j));
-                values.push(v);
-                full[(i, j)] += v;
-            }
-        }
-        let mut s = IterationMatrix::new(n, &entries).unwrap();
-        s.factorise(&values).unwrap();
+        let m = drifted_banded(n, 0.0);
+        let mut s = IterationMatrix::new(n, &m.entries).unwrap();
+        s.factorise(&m.values).unwrap();
         assert!(
             s.layout()
                 .factors
@@ -948,7 +934,7 @@ mod tests {
             "the test matrix must make the LU pivot"
         );
         let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
-        for (i, (x, reference)) in solved_and_dense(&mut s, &full, &rhs)
+        for (i, (x, reference)) in solved_and_dense(&mut s, &m.full, &rhs)
             .into_iter()
             .enumerate()
         {
@@ -961,8 +947,9 @@ mod tests {
         }
     }
 
-    /// The pivoted banded matrix above with every entry scaled by 1 + `drift`·sin(…): what an
-    /// aging iteration matrix looks like.
+    /// A banded matrix (bandwidth 3) with a small diagonal under O(1) neighbours, so that partial
+    /// pivoting swaps rows, every entry scaled by 1 + `drift`·sin(…): what an aging iteration
+    /// matrix looks like.
     fn drifted_banded(n: usize, drift: f64) -> TestMatrix {
         let mut m = TestMatrix::new(n);
         for i in 0..n {
