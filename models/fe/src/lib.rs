@@ -549,11 +549,21 @@ impl CableModel for Fe {
     /// l_i [m], stored lengths ρ_i [m].
     fn channels(&self, y: &[f64], _tensions: [f64; 2], out: &mut [f64]) {
         let n = self.elements;
+        // Elements N (at the effector) and 1 (at the pulley) of each cable, from one span each
+        // (this runs per output sample); the same states as `element_tension`'s, bit for bit.
+        let [(effector_1, pulley_1), (effector_2, pulley_2)] = [0, 1].map(|cable| {
+            let span = self.span_of(y, cable);
+            let tension = |e: usize| {
+                let s = span.element(self.node(y, cable, e - 1), self.node(y, cable, e));
+                s.tension(self.material.ea, (s.rb - s.ra).norm()).1
+            };
+            (tension(n), tension(1))
+        });
         out.copy_from_slice(&[
-            self.element_tension(y, 0, n).1,
-            self.element_tension(y, 1, n).1,
-            self.element_tension(y, 0, 1).1,
-            self.element_tension(y, 1, 1).1,
+            effector_1,
+            effector_2,
+            pulley_1,
+            pulley_2,
             self.free_length(y, 0),
             self.free_length(y, 1),
             self.stored_length(y, 0),
@@ -595,6 +605,13 @@ mod tests {
                     );
                 }
             }
+            // The channels' end tensions, computed per span, are `element_tension`'s.
+            let mut out = vec![0.0; fe.channel_names().len()];
+            fe.channels(&y, [100.0, 100.0], &mut out);
+            let n = elements as usize;
+            let expected =
+                [(0, n), (1, n), (0, 1), (1, 1)].map(|(c, e)| fe.element_tension(&y, c, e).1);
+            assert_eq!(out[..4], expected);
         }
     }
 }
