@@ -2,8 +2,9 @@
 //! R = diag(m) q'' − F(q, q', T), with F the spring, gravity and reel forces of [`Lumped::forces`]
 //! (a stored node's vertical force is the constraint's business: its row reads m z'' = 0, so it
 //! stays on z = 0 exactly). The iteration matrix is diag(m), written exactly, plus coloured
-//! finite differences of F over the chain's pattern: every node couples only to its two neighbours along its cable (the straddling
-//! spring included: its ends are neighbours too), the effector to the last node of each cable.
+//! finite differences of F over the chain's pattern: every node couples only to its two
+//! neighbours along its cable (the straddling spring included: its ends are neighbours too), the
+//! effector to the last node of each cable.
 //! The pattern does not depend on which nodes are stored, so pulley events never change it.
 
 use crate::Lumped;

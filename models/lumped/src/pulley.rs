@@ -55,7 +55,8 @@ pub(crate) fn event_functions(model: &Lumped, y: &[f64], out: &mut [f64]) {
 
 /// min over `x` of `f` (∞ for none), in four independent lanes: a sequential min is a chain of
 /// dependent instructions, and this runs at every step. A min is exact, so the lanes change no
-/// bit of the result.
+/// bit of the result (but the sign of a zero, which the event location, comparing signs, cannot
+/// see).
 fn smallest(x: &[f64], f: impl Fn(f64) -> f64) -> f64 {
     let mut lanes = [f64::INFINITY; 4];
     let chunks = x.chunks_exact(4);
