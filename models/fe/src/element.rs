@@ -102,6 +102,12 @@ impl ElementState {
         let strain = length * self.inv_h - 1.0;
         (strain, ea * strain.max(0.0))
     }
+
+    /// [`Self::tension`] at the element's chord length |r_b − r_a|.
+    #[inline]
+    pub fn chord_tension(&self, ea: f64) -> (f64, f64) {
+        self.tension(ea, (self.rb - self.ra).norm())
+    }
 }
 
 /// What an element adds to M and F (FE.5.3), in its local unknowns (r_a, r_b, l).

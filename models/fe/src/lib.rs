@@ -238,8 +238,13 @@ impl Fe {
     /// State of element e (1…N) of `cable`.
     #[inline]
     fn free_element(&self, y: &[f64], cable: usize, e: usize) -> ElementState {
-        self.span_of(y, cable)
-            .element(self.node(y, cable, e - 1), self.node(y, cable, e))
+        self.element_of(&self.span_of(y, cable), y, cable, e)
+    }
+
+    /// State of element e (1…N) of `cable`, whose span is `span` (from [`Self::span_of`]).
+    #[inline]
+    fn element_of(&self, span: &Span, y: &[f64], cable: usize, e: usize) -> ElementState {
+        span.element(self.node(y, cable, e - 1), self.node(y, cable, e))
     }
 
     /// The N elements of `cable`'s span in order e = 1 (at the pulley) … N (at the effector),
@@ -410,14 +415,16 @@ impl Fe {
 
     /// Strain and tension (ε, N_e) of element e (1…N) of `cable` [–, N].
     pub fn element_tension(&self, y: &[f64], cable: usize, e: usize) -> (f64, f64) {
-        let s = self.free_element(y, cable, e);
-        s.tension(self.material.ea, (s.rb - s.ra).norm())
+        self.free_element(y, cable, e)
+            .chord_tension(self.material.ea)
     }
 
     /// Strain and tension of the stored element of `cable` (None for the rigid stored cable).
     pub fn stored_tension(&self, y: &[f64], cable: usize) -> Option<(f64, f64)> {
-        let s = self.stored_element(y, cable)?;
-        Some(s.tension(self.material.ea, (s.rb - s.ra).norm()))
+        Some(
+            self.stored_element(y, cable)?
+                .chord_tension(self.material.ea),
+        )
     }
 
     /// Unstrained free length l_i [m].
@@ -554,8 +561,9 @@ impl CableModel for Fe {
         let [(effector_1, pulley_1), (effector_2, pulley_2)] = [0, 1].map(|cable| {
             let span = self.span_of(y, cable);
             let tension = |e: usize| {
-                let s = span.element(self.node(y, cable, e - 1), self.node(y, cable, e));
-                s.tension(self.material.ea, (s.rb - s.ra).norm()).1
+                self.element_of(&span, y, cable, e)
+                    .chord_tension(self.material.ea)
+                    .1
             };
             (tension(n), tension(1))
         });

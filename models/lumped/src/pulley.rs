@@ -22,9 +22,16 @@ const PER_CABLE: usize = 3;
 /// Event functions of the model.
 pub(crate) const EVENT_COUNT: usize = 2 * PER_CABLE;
 
+/// The side rule's signed distance beyond `cable`'s pulley along e_out of a node at x [m]
+/// (> 0: on the reel side), as a function of x (the pulley looked up once).
+fn beyond_at(model: &Lumped, cable: usize) -> impl Fn(f64) -> f64 {
+    let (pulley, e_out) = (model.pulley(cable).x, E_OUT[cable]);
+    move |x| (x - pulley) * e_out
+}
+
 /// Signed distance of node j beyond the pulley along e_out (> 0: on the reel side) [m].
-fn beyond(model: &Lumped, y: &[f64], cable: usize, j: usize) -> f64 {
-    (y[model.xi(cable, j)] - model.pulley(cable).x) * E_OUT[cable]
+pub(crate) fn beyond(model: &Lumped, y: &[f64], cable: usize, j: usize) -> f64 {
+    beyond_at(model, cable)(y[model.xi(cable, j)])
 }
 
 /// All event functions, positive while nothing happens (see [`CableModel::event_functions`]).
@@ -33,22 +40,15 @@ pub(crate) fn event_functions(model: &Lumped, y: &[f64], out: &mut [f64]) {
     for cable in 0..2 {
         let r = model.stored()[cable];
         let g = &mut out[PER_CABLE * cable..PER_CABLE * (cable + 1)];
-        g[0] = if r > 0 {
-            beyond(model, y, cable, r - 1)
-        } else {
-            1.0
-        };
-        g[1] = if r < n {
-            -beyond(model, y, cable, r)
-        } else {
-            1.0
-        };
-        // Over the cable's contiguous x: stored nodes but the last, free nodes but the first.
+        // The cable's nodes' x, contiguous.
         let start = model.xi(cable, 0);
         let x = &y[start..start + n];
-        let (a, e) = (model.pulley(cable).x, E_OUT[cable]);
-        let stored_watch = smallest(&x[..r.saturating_sub(1)], |xj| (xj - a) * e);
-        let free_watch = smallest(&x[(r + 1).min(n)..], |xj| -((xj - a) * e));
+        let beyond = beyond_at(model, cable);
+        g[0] = if r > 0 { beyond(x[r - 1]) } else { 1.0 };
+        g[1] = if r < n { -beyond(x[r]) } else { 1.0 };
+        // Stored nodes but the last, free nodes but the first.
+        let stored_watch = smallest(&x[..r.saturating_sub(1)], &beyond);
+        let free_watch = smallest(&x[(r + 1).min(n)..], |xj| -beyond(xj));
         g[2] = stored_watch.min(free_watch).min(1.0);
     }
 }

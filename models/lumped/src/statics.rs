@@ -7,6 +7,7 @@
 //! shifted by one node until it holds, so any start position inside the workspace finds its own
 //! straddling spring.
 
+use crate::pulley::beyond;
 use crate::{E_OUT, Lumped};
 use cdpr_core::model::{CableModel, Equilibrium, ModelError};
 use cdpr_core::second_order::SecondOrderForm;
@@ -152,11 +153,6 @@ fn guess(model: &mut Lumped, effector: Vector2<f64>, tension: f64, ea: f64) -> V
 
 /// Splits tried before giving up (a start needs at most one or two shifts).
 const MAX_SPLITS: usize = 6;
-
-/// (P_j − A)·e_out of node j of `cable` (> 0: stored side).
-fn beyond(model: &Lumped, y: &[f64], cable: usize, j: usize) -> f64 {
-    (y[model.xi(cable, j)] - model.pulley(cable).x) * E_OUT[cable]
-}
 
 /// Switches to the split `stored`: a node changing sides starts just on its new side of the
 /// pulley, on its new path (the straddling spring's length has a kink at the pulley that Newton

@@ -30,8 +30,8 @@
 //! Gilbert–Peierls LU with partial pivoting at the first factorisation); later factorisations
 //! reuse that pivot sequence and recompute only the numbers on the known pattern ([`Factors`],
 //! as KLU's refactor), and pivot afresh through faer only when a reused pivot falls below a tenth
-//! of its column. Lumped N = 40 paper run: 2 of 3 000 factorisations pivot, and the run went
-//! 0.50 -> 0.45 s (one sample per step); faer 0.24 has no such numeric-only path. The solve,
+//! of its column. Lumped N = 40 paper run: 2 of 4 568 factorisations pivot; reusing the pivots took
+//! the run 0.50 -> 0.45 s (one sample per step). faer 0.24 has no such numeric-only path. The solve,
 //! which runs once per Newton iteration, sweeps the factors by columns itself: U's diagonal
 //! inverted once per factorisation instead of divided at every solve, the permutations folded
 //! into the gather and scatter (lumped N = 40, n = 162: 2.05 µs per solve against 2.3 µs through
@@ -136,24 +136,22 @@ impl SolveCost {
         (Self::LINK * self.chain).max(self.nonzeros) + self.border
     }
 
-    fn of(lu: &SimplicialLu<usize, f64>, border: usize) -> Self {
-        let (l, u) = (lu.l_factor_unsorted(), lu.u_factor_unsorted());
-        let n = lu.nrows();
+    fn of(f: &Factors, border: usize) -> Self {
+        let n = f.u_inv_diag.len();
         let mut ready = vec![0usize; n];
         let mut finish = vec![0usize; n];
         // Forward sweep in column order: x_i waits for every x_j with L_ij ≠ 0, j < i.
-        let (l_ptr, l_row) = (l.symbolic().col_ptr(), l.symbolic().row_idx());
         let forward = Self::sweep(0..n, &mut ready, &mut finish, |j| {
-            &l_row[l_ptr[j] + 1..l_ptr[j + 1]]
+            &f.l_row[f.l_ptr[j]..f.l_ptr[j + 1]]
         });
         ready.fill(0);
         // Backward sweep: x_i waits for every x_j with U_ij ≠ 0, j > i.
-        let (u_ptr, u_row) = (u.symbolic().col_ptr(), u.symbolic().row_idx());
         let backward = Self::sweep((0..n).rev(), &mut ready, &mut finish, |j| {
-            &u_row[u_ptr[j]..u_ptr[j + 1] - 1]
+            &f.u_row[f.u_ptr[j]..f.u_ptr[j + 1]]
         });
         Self {
-            nonzeros: l.val().len() + u.val().len(),
+            // The diagonals of L (unit) and U count too.
+            nonzeros: f.l_row.len() + f.u_row.len() + 2 * n,
             chain: forward + backward,
             border,
         }
@@ -551,7 +549,7 @@ impl Layout {
 
     fn solve_cost(&self) -> SolveCost {
         let (k, ni) = (self.border.len(), self.interior.len());
-        SolveCost::of(&self.numeric, k * ni + self.c_val.len() + k * k)
+        SolveCost::of(&self.factors, k * ni + self.c_val.len() + k * k)
     }
 
     /// Overwrites `rhs` with S⁻¹ rhs (the last factorisation).
@@ -611,7 +609,7 @@ struct Factors {
     l_ptr: Vec<usize>,
     l_row: Vec<usize>,
     l_val: Vec<f64>,
-    /// U by columns, rows ascending, the diagonal last.
+    /// U's strict upper part by columns, rows ascending, and U's inverse diagonal.
     u_ptr: Vec<usize>,
     u_row: Vec<usize>,
     u_val: Vec<f64>,
@@ -673,8 +671,8 @@ impl Factors {
                 self.l_val.push(l_val[k]);
             }
             self.l_ptr.push(self.l_row.len());
-            // U's diagonal is the last entry of its column; the rest sorted for the
-            // refactorisation's left-looking order.
+            // U's diagonal is the last entry of its column (kept as its inverse); the rest
+            // sorted for the refactorisation's left-looking order.
             let start = self.u_row.len();
             let last = u_ptr[j + 1] - 1;
             self.u_row.extend_from_slice(&u_row[u_ptr[j]..last]);
@@ -688,8 +686,6 @@ impl Factors {
             {
                 (*r, *v) = (sr, sv);
             }
-            self.u_row.push(j);
-            self.u_val.push(u_val[last]);
             self.u_ptr.push(self.u_row.len());
             self.u_inv_diag.push(1.0 / u_val[last]);
         }
@@ -716,8 +712,7 @@ impl Factors {
             }
             // Left-looking: x ← L(0..j)⁻¹ x over U's pattern in column j, in ascending order (a
             // row is final once every earlier column of L has updated it).
-            let (u_start, diag) = (self.u_ptr[j], self.u_ptr[j + 1] - 1);
-            for q in u_start..diag {
+            for q in self.u_ptr[j]..self.u_ptr[j + 1] {
                 let k = self.u_row[q];
                 let xk = x[k];
                 self.u_val[q] = xk;
@@ -738,7 +733,6 @@ impl Factors {
                 // Columns j + 1… were never written: clear what this one scattered.
                 return false;
             }
-            self.u_val[diag] = pivot;
             self.u_inv_diag[j] = inv;
             for t in self.l_ptr[j]..self.l_ptr[j + 1] {
                 let i = self.l_row[t];
@@ -770,7 +764,7 @@ impl Factors {
         for j in (0..x.len()).rev() {
             let xj = x[j] * self.u_inv_diag[j];
             x[j] = xj;
-            for k in self.u_ptr[j]..self.u_ptr[j + 1] - 1 {
+            for k in self.u_ptr[j]..self.u_ptr[j + 1] {
                 x[self.u_row[k]] -= self.u_val[k] * xj;
             }
         }
