@@ -8,8 +8,8 @@
 
 use crate::controller::{Pid, PidState, TensionDistribution};
 use crate::integrate::{
-    Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions, IntegratorError, OdeSystem,
-    SecondOrderSystem, SolverStats, Stepper,
+    Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions, IntegratorError, MatrixCost,
+    OdeSystem, SecondOrderSystem, SolverStats, Stepper,
 };
 use crate::model::{CableModel, Equilibrium, ModelError, ModelEvent};
 use crate::scenario::{IntegratorKind, Scenario};
@@ -234,7 +234,7 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         c_v: f64,
         c_q: f64,
         values: &mut [f64],
-    ) -> u64 {
+    ) -> MatrixCost {
         let n = self.model_len();
         // dT/dx of the effector through the trapezoidal PID: T is affine in x (unless saturated),
         // so a unit difference is exact.
@@ -244,12 +244,12 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         let slope = [moved[0] - tensions[0], moved[1] - tensions[1]];
         let [base, probe] = &mut self.residual_scratch;
         let Some(form) = self.model.second_order_mut() else {
-            return 0;
+            return MatrixCost::default();
         };
         // The pattern is the model's, then one entry (row, x) per tension row.
         let rows = form.tension_rows();
         let (model_values, tension_values) = values.split_at_mut(values.len() - rows.len());
-        let mut evals = form.iteration_matrix(&y[..n], qdd, tensions, c_v, c_q, model_values);
+        let mut cost = form.iteration_matrix(&y[..n], qdd, tensions, c_v, c_q, model_values);
         if slope != [0.0, 0.0] && !rows.is_empty() {
             // Column x of ∂R/∂T · dT/dx, by two more residuals (R is linear in T).
             base.resize(form.dofs(), 0.0);
@@ -257,14 +257,14 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
             form.residual(&y[..n], qdd, tensions, base);
             let pulled = [tensions[0] + slope[0], tensions[1] + slope[1]];
             form.residual(&y[..n], qdd, pulled, probe);
-            evals += 2;
+            cost = cost.plus_residuals(2);
             for (value, &row) in tension_values.iter_mut().zip(&rows) {
                 *value = c_q * (probe[row] - base[row]);
             }
         } else {
             tension_values.fill(0.0);
         }
-        evals
+        cost
     }
 
     fn tail_rate(&mut self, t: f64, y: &[f64], out: &mut [f64]) {

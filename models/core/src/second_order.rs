@@ -7,6 +7,8 @@
 //! model. The tensions enter R linearly; the closed loop adds their dependence on the effector
 //! through the controller, so a model never sees the controller.
 
+pub use crate::integrate::MatrixCost;
+
 /// M(q) q'' − F(q, q', T) of a model, with its iteration matrix.
 pub trait SecondOrderForm {
     /// Number n of generalised coordinates.
@@ -36,7 +38,8 @@ pub trait SecondOrderForm {
     /// R = M(q) q'' − F(q, q', T) for state `[q | q']` into `r` (n).
     fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]);
     /// S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q at fixed tensions, in the order of
-    /// [`Self::iteration_pattern`]. Returns the residual evaluations it used (0 if analytic).
+    /// [`Self::iteration_pattern`]. Returns what it cost (residual evaluations made, and its
+    /// whole cost in them).
     #[allow(clippy::too_many_arguments)]
     fn iteration_matrix(
         &mut self,
@@ -46,7 +49,7 @@ pub trait SecondOrderForm {
         c_v: f64,
         c_q: f64,
         values: &mut [f64],
-    ) -> u64;
+    ) -> MatrixCost;
 }
 
 /// Round-off bound of a spring model's residual [N]: a node's force sums two springs, each

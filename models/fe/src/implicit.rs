@@ -15,7 +15,7 @@
 
 use crate::element::{self, ElementState};
 use crate::{E_OUT, Fe};
-use cdpr_core::second_order::{SecondOrderForm, central_step, spring_round_off};
+use cdpr_core::second_order::{MatrixCost, SecondOrderForm, central_step, spring_round_off};
 use nalgebra::Vector2;
 
 /// One additive block of R: an element, the rigid stored cable or the effector.
@@ -331,9 +331,10 @@ impl SecondOrderForm for Fe {
         c_v: f64,
         c_q: f64,
         values: &mut [f64],
-    ) -> u64 {
+    ) -> MatrixCost {
         self.block_matrix(state, qdd, [c_q, c_v, 1.0], values);
-        // One base and 5 × (1 + 2 + 2) probes per block: the cost of about 26 residual sweeps.
-        26
+        // Element-local differences, no full residual: one base and 5 × (1 + 2 + 2) probes per
+        // block, the cost of about 26 residual sweeps (what the refresh rule weighs).
+        MatrixCost::equivalent(26)
     }
 }

@@ -9,7 +9,7 @@
 
 use crate::Lumped;
 use cdpr_core::second_order::{
-    CBRT_EPSILON, ColouredDifferences, SecondOrderForm, spring_round_off,
+    CBRT_EPSILON, ColouredDifferences, MatrixCost, SecondOrderForm, spring_round_off,
 };
 
 /// Buffers of the second-order form (allocated once per model).
@@ -128,7 +128,7 @@ impl SecondOrderForm for Lumped {
         c_v: f64,
         c_q: f64,
         values: &mut [f64],
-    ) -> u64 {
+    ) -> MatrixCost {
         let mut differences = match self.implicit.differences.take() {
             Some(d) => d,
             None => {
@@ -151,6 +151,6 @@ impl SecondOrderForm for Lumped {
             values,
         );
         self.implicit.differences = Some(differences);
-        evals
+        MatrixCost::differences(evals)
     }
 }

@@ -25,7 +25,7 @@
 //! of the step (one right-hand-side evaluation per step), third order, above the method's own.
 
 use super::sparse::IterationMatrix;
-use super::{IntegratorError, OdeSystem, SolverStats, Stepper};
+use super::{IntegratorError, MatrixCost, OdeSystem, SolverStats, Stepper};
 
 /// A second-order system with a first-order tail, as the implicit integrator sees it.
 ///
@@ -48,7 +48,7 @@ pub trait SecondOrderSystem: OdeSystem {
     /// R = M(q) q'' − F(t, q, q', …) (n rows) for the iterate whose q, q' are `y[..2n]`.
     fn residual(&mut self, t: f64, y: &[f64], qdd: &[f64], r: &mut [f64]);
     /// S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q at the iterate, in the order of
-    /// [`Self::iteration_pattern`] (duplicates are summed). Returns the residual evaluations used.
+    /// [`Self::iteration_pattern`] (duplicates are summed). Returns what it cost.
     #[allow(clippy::too_many_arguments)]
     fn iteration_matrix(
         &mut self,
@@ -58,7 +58,7 @@ pub trait SecondOrderSystem: OdeSystem {
         c_v: f64,
         c_q: f64,
         values: &mut [f64],
-    ) -> u64;
+    ) -> MatrixCost;
     /// Writes the tail `y[2n..]` at the end t of an accepted step whose q, q' are `y[..2n]`.
     fn end_step(&mut self, t: f64, y: &mut [f64]);
     /// The tail's rate at (t, y) into `out` (the dense output's derivative; q' and q'' come from
@@ -223,9 +223,10 @@ pub struct GeneralizedAlpha {
     matrix: Option<IterationMatrix>,
     /// Step the current factorisation was built for (0: none).
     matrix_h: f64,
-    /// Residual evaluations the last refresh cost, and Newton iterations beyond one per step spent
-    /// since (the refresh rule of [`Self::refresh_pays`]).
-    refresh_evals: u64,
+    /// What the last refresh cost in residual evaluations ([`MatrixCost::in_residuals`]), and
+    /// Newton iterations beyond one per step spent since (the refresh rule of
+    /// [`Self::refresh_pays`]).
+    refresh_cost: u64,
     excess_iterations: u64,
     stats: SolverStats,
 }
@@ -253,7 +254,7 @@ impl GeneralizedAlpha {
             values: Vec::new(),
             matrix: None,
             matrix_h: 0.0,
-            refresh_evals: 0,
+            refresh_cost: 0,
             excess_iterations: 0,
             stats: SolverStats::default(),
         }
@@ -275,7 +276,7 @@ impl GeneralizedAlpha {
     /// where they moved by more than 1e-6 relative needs 1.96: many small drifts matter, not a
     /// few large ones, so no local update of the matrix would do.
     fn refresh_pays(&self) -> bool {
-        self.refresh_evals > 0 && self.excess_iterations >= self.refresh_evals
+        self.refresh_cost > 0 && self.excess_iterations >= self.refresh_cost
     }
 
     /// Counters so far.
@@ -351,10 +352,10 @@ impl GeneralizedAlpha {
         h: f64,
     ) -> Result<(), IntegratorError> {
         let (c_v, c_q) = self.coeff.derivatives(h);
-        let evals = sys.iteration_matrix(t, &self.y_try, &self.qdd_try, c_v, c_q, &mut self.values);
-        self.stats.rhs_evals += evals;
+        let cost = sys.iteration_matrix(t, &self.y_try, &self.qdd_try, c_v, c_q, &mut self.values);
+        self.stats.rhs_evals += cost.residual_evals;
         self.stats.jacobian_evals += 1;
-        self.refresh_evals = evals;
+        self.refresh_cost = cost.in_residuals;
         self.excess_iterations = 0;
         let matrix = self
             .matrix
@@ -508,7 +509,7 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
         }
         let pattern = sys.iteration_pattern();
         self.values = vec![0.0; pattern.len()];
-        (self.refresh_evals, self.excess_iterations) = (0, 0);
+        (self.refresh_cost, self.excess_iterations) = (0, 0);
         self.matrix = Some(IterationMatrix::with_coupled(
             n,
             &pattern,

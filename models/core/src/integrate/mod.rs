@@ -13,6 +13,47 @@ pub use generalized_alpha::{
     AlphaCoefficients, GeneralizedAlpha, GeneralizedAlphaOptions, SecondOrderSystem,
 };
 
+/// What one evaluation of an implicit method's iteration matrix cost, in two parts kept apart:
+/// the full residual evaluations it made (counted in [`SolverStats::rhs_evals`], which MODELS.md
+/// §6 asks us to report), and its whole cost in residual evaluations, which the refresh rule
+/// weighs against Newton iterations. They differ for a matrix that is not a finite difference of
+/// the whole residual (an analytic one, or the FE model's element-local differences).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct MatrixCost {
+    /// Full residual evaluations made.
+    pub residual_evals: u64,
+    /// Cost of the whole evaluation in residual evaluations (0: free, or unknown; then the
+    /// matrix is refreshed only when Newton slows).
+    pub in_residuals: u64,
+}
+
+impl MatrixCost {
+    /// A matrix made of `evals` full residual evaluations (finite differences) and little else.
+    pub fn differences(evals: u64) -> Self {
+        Self {
+            residual_evals: evals,
+            in_residuals: evals,
+        }
+    }
+
+    /// A matrix that made no residual evaluation but costs about `in_residuals` of them.
+    pub fn equivalent(in_residuals: u64) -> Self {
+        Self {
+            residual_evals: 0,
+            in_residuals,
+        }
+    }
+
+    /// This cost plus `evals` full residual evaluations made on top (e.g. a column the closed
+    /// loop adds).
+    pub fn plus_residuals(self, evals: u64) -> Self {
+        Self {
+            residual_evals: self.residual_evals + evals,
+            in_residuals: self.in_residuals + evals,
+        }
+    }
+}
+
 /// A first-order system y' = f(t, y) of fixed dimension.
 pub trait OdeSystem {
     /// Number of state components.
@@ -38,8 +79,9 @@ pub struct SolverStats {
     /// Newton iterations (implicit methods; each costs one residual evaluation, counted in
     /// `rhs_evals`).
     pub newton_iterations: u64,
-    /// Iteration-matrix (Jacobian) evaluations (implicit methods; their finite-difference residual
-    /// evaluations are counted in `rhs_evals` too).
+    /// Iteration-matrix (Jacobian) evaluations (implicit methods). The full residual evaluations
+    /// of a finite-difference matrix are counted in `rhs_evals` too; an analytic or element-local
+    /// matrix adds none ([`MatrixCost`]).
     pub jacobian_evals: u64,
     /// Numeric LU factorisations of the iteration matrix (implicit methods).
     pub factorisations: u64,
