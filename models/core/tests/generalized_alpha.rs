@@ -316,7 +316,7 @@ fn discrete_mode_matches_the_integrated_oscillator() {
 
 /// Kepler's problem with counted evaluations and a stated matrix cost: its iteration matrix makes
 /// `cost.residual_evals` residual evaluations of its own (as finite differences would) and claims
-/// to cost `cost.in_residuals`.
+/// to cost `cost.refresh_price`.
 struct CountedKepler {
     cost: MatrixCost,
     evaluations: u64,
@@ -375,7 +375,7 @@ proptest! {
         step in 5e-3f64..5e-2,
     ) {
         let mut sys = CountedKepler {
-            cost: MatrixCost { residual_evals: made, in_residuals: made + extra },
+            cost: MatrixCost { residual_evals: made, refresh_price: made + extra },
             evaluations: 0,
         };
         let (_, ga) = run(&mut sys, &[1.0, 0.0, 0.0, 1.0], 2.0, step, 0.9, 1e-10);

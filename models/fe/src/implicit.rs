@@ -334,7 +334,7 @@ impl SecondOrderForm for Fe {
     ) -> MatrixCost {
         self.block_matrix(state, qdd, [c_q, c_v, 1.0], values);
         // Element-local differences, no full residual: one base and 5 × (1 + 2 + 2) probes per
-        // block, the cost of about 26 residual sweeps (what the refresh rule weighs).
-        MatrixCost::equivalent(26)
+        // block, the cost of about 26 residual sweeps, which is the refresh rule's price.
+        MatrixCost::without_residuals(26)
     }
 }

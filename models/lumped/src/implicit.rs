@@ -1,8 +1,10 @@
 //! The lumped model's second-order form for the implicit integrator (MODELS.md §6):
 //! R = diag(m) q'' − F(q, q', T), with F the spring, gravity and reel forces of [`Lumped::forces`]
 //! (a stored node's vertical force is the constraint's business: its row reads m z'' = 0, so it
-//! stays on z = 0 exactly). The iteration matrix is diag(m), written exactly, plus coloured
-//! finite differences of F over the chain's pattern: every node couples only to its two
+//! stays on z = 0 exactly). The iteration matrix is diag(m) plus, for undamped springs (the
+//! paper's run), the springs' analytic tangent stiffness (~2 µs against ~7 µs for the 18
+//! residual evaluations of coloured central differences, which remain for damped springs and as
+//! the test's reference). Its pattern is the chain's: every node couples only to its two
 //! neighbours along its cable (the straddling spring included: its ends are neighbours too), the
 //! effector to the last node of each cable.
 //! The pattern does not depend on which nodes are stored, so pulley events never change it.
@@ -11,6 +13,7 @@ use crate::Lumped;
 use cdpr_core::second_order::{
     CBRT_EPSILON, ColouredDifferences, MatrixCost, SecondOrderForm, spring_round_off,
 };
+use nalgebra::Vector2;
 
 /// Buffers of the second-order form (allocated once per model).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -19,10 +22,127 @@ pub(crate) struct ImplicitScratch {
     differences: Option<ColouredDifferences>,
 }
 
+/// The refresh rule's price of an analytic lumped matrix, in Newton iterations beyond one per
+/// step ([`MatrixCost::refresh_price`]). A refresh (matrix ~2 µs, factorisation ~7 µs) costs
+/// about 9 iterations (~1.05 µs each with the paired solve), but buys few: the lumped matrix
+/// ages within a step (see the refresh rule in `generalized_alpha.rs`), so iterations per step
+/// stay near 2 however often it is refreshed. Paper run (N = 40, one sample per step), price
+/// → refreshes, iterations, time: 4 → 9 191, 103 269, 0.372 s; 16 → 4 533, 109 066, 0.318 s;
+/// 32 → 3 285, 111 295, 0.302 s; 48 → 2 843, 113 284, 0.299 s; 64 → 2 596, 114 636, 0.297 s;
+/// 128 → 2 254, 120 387, 0.302 s; never (slow contraction only) → 1 915, 137 237, 0.324 s.
+/// Between 16 and 48 a refresh saved 2.5 iterations, between 64 and 128 it saved 17: the
+/// break-even (~8) lies between, and the time is flat (±1 %) from 32 to 128. At N = 100 and 300
+/// (5 s runs) prices 16 … 64 differ by less than this host's noise (±5 %).
+const TANGENT_REFRESH_PRICE: u64 = 48;
+
 impl Lumped {
     /// Coordinates (x, z indices) of node j of `cable` (the effector at j = N).
     fn coordinates(&self, cable: usize, j: usize) -> [usize; 2] {
         [self.xi(cable, j), self.zi(cable, j)]
+    }
+
+    /// Index into [`SecondOrderForm::iteration_pattern`] of entry (row `r`, column `c`; 0 = x,
+    /// 1 = z) of the block coupling node `row` to node `col` of `cable` (adjacent or equal; the
+    /// effector is node N). The pattern lists, per spring j (nodes j, j + 1), 12 entries: for
+    /// each coordinate of node j, its two entries with node j, then (j, j + 1) and (j + 1, j)
+    /// pairs; after both cables, the effector's own 2 × 2 block.
+    fn pattern_index(&self, cable: usize, row: usize, col: usize, r: usize, c: usize) -> usize {
+        let n = self.elements;
+        let slot = |j: usize| 12 * (cable * n + j);
+        if row == col {
+            if row == n {
+                24 * n + 2 * r + c
+            } else {
+                slot(row) + 6 * r + c
+            }
+        } else if col == row + 1 {
+            slot(row) + 6 * r + 2 + 2 * c
+        } else {
+            debug_assert_eq!(row, col + 1);
+            slot(col) + 6 * c + 3 + 2 * r
+        }
+    }
+
+    /// S = diag(m) − c_q ∂F/∂q for undamped springs, analytically, into `values` (pattern
+    /// order). A taut chord spring (u = (b − a)/λ, T = k (λ − l0)) pulls a with T u, whose
+    /// derivative in b is K = k u uᵀ + (T/λ)(I − u uᵀ) (in a: −K; b's force the opposite). The
+    /// straddling spring (λ = |P − a| + |P − b|, eq. 4) pulls each end towards the pulley,
+    /// F_a = T u_a: ∂F_a/∂a = −k u_a u_aᵀ − (T/|P − a|)(I − u_a u_aᵀ), ∂F_a/∂b = −k u_a u_bᵀ. A
+    /// slack spring adds nothing; a stored node's z row is its mass alone (MODELS.md §4: the
+    /// constraint holds it on z = 0). False (values unusable) where a straddling end sits exactly
+    /// at its pulley (no direction there).
+    fn tangent_matrix(&self, state: &[f64], c_q: f64, values: &mut [f64]) -> bool {
+        let n = self.elements;
+        values.fill(0.0);
+        for cable in 0..2 {
+            for j in 0..n {
+                for r in 0..2 {
+                    values[self.pattern_index(cable, j, j, r, r)] = self.node_mass;
+                }
+            }
+        }
+        for r in 0..2 {
+            values[self.pattern_index(0, n, n, r, r)] = self.effector_mass;
+        }
+        let (k, l0) = (self.stiffness, self.segment);
+        let outer = |u: Vector2<f64>, w: Vector2<f64>| u * w.transpose();
+        let identity = nalgebra::Matrix2::identity();
+        for cable in 0..2 {
+            let stored = self.stored[cable];
+            for j in 0..n {
+                let (a, b) = (self.node(state, cable, j), self.node(state, cable, j + 1));
+                // ∂F_a/∂a, ∂F_a/∂b, ∂F_b/∂a, ∂F_b/∂b.
+                let blocks = if j + 1 == stored {
+                    let pulley = self.pulley(cable);
+                    let (da, db) = (pulley - a, pulley - b);
+                    let (la, lb) = (da.norm(), db.norm());
+                    if la == 0.0 || lb == 0.0 {
+                        return false;
+                    }
+                    let stretch = la + lb - l0;
+                    if stretch <= 0.0 {
+                        continue;
+                    }
+                    let t = k * stretch;
+                    let (ua, ub) = (da / la, db / lb);
+                    let across_a = (identity - outer(ua, ua)) * (t / la);
+                    let across_b = (identity - outer(ub, ub)) * (t / lb);
+                    [
+                        -outer(ua, ua) * k - across_a,
+                        -outer(ua, ub) * k,
+                        -outer(ub, ua) * k,
+                        -outer(ub, ub) * k - across_b,
+                    ]
+                } else {
+                    let d = b - a;
+                    let length = d.norm();
+                    let stretch = length - l0;
+                    if stretch <= 0.0 {
+                        continue;
+                    }
+                    let u = d / length;
+                    let along = outer(u, u);
+                    let tangent = along * k + (identity - along) * (k * stretch / length);
+                    [-tangent, tangent, tangent, -tangent]
+                };
+                for (block, (row, col)) in
+                    blocks
+                        .iter()
+                        .zip([(j, j), (j, j + 1), (j + 1, j), (j + 1, j + 1)])
+                {
+                    for r in 0..2 {
+                        if r == 1 && row < stored {
+                            continue;
+                        }
+                        for c in 0..2 {
+                            values[self.pattern_index(cable, row, col, r, c)] -=
+                                c_q * block[(r, c)];
+                        }
+                    }
+                }
+            }
+        }
+        true
     }
 
     fn residual_into(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]) {
@@ -120,7 +240,28 @@ impl SecondOrderForm for Lumped {
         }
     }
 
+    /// Analytic for undamped springs (the paper's run), whose forces depend on the positions
+    /// alone ([`Lumped::tangent_matrix`]); coloured central differences of the residual
+    /// otherwise, or where a straddling spring's end sits exactly at its pulley.
     fn iteration_matrix(
+        &mut self,
+        state: &[f64],
+        qdd: &[f64],
+        tensions: [f64; 2],
+        c_v: f64,
+        c_q: f64,
+        values: &mut [f64],
+    ) -> MatrixCost {
+        if self.damping == 0.0 && self.tangent_matrix(state, c_q, values) {
+            return MatrixCost::without_residuals(TANGENT_REFRESH_PRICE);
+        }
+        self.differenced_matrix(state, qdd, tensions, c_v, c_q, values)
+    }
+}
+
+impl Lumped {
+    /// S by coloured central differences of the residual (any damping).
+    fn differenced_matrix(
         &mut self,
         state: &[f64],
         qdd: &[f64],
@@ -152,5 +293,59 @@ impl SecondOrderForm for Lumped {
         );
         self.implicit.differences = Some(differences);
         MatrixCost::differences(evals)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cdpr_core::model::CableModel;
+    use cdpr_core::scenario::{ModelKind, Scenario};
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+
+        /// The analytic matrix against the model's own coloured central differences, at static
+        /// equilibria whose free nodes are shaken by up to 3e-5 m (twice the springs' stretch
+        /// of ~1.4e-5 m, so some go slack; the differences' steps stay within a quarter of each
+        /// stretch and never cross the kink), over the weights c_q of h = 1e-5 … 1e-3 s. The
+        /// differences' truncation is (δ/λ)² ≈ 2e-7 of an entry (δ ≤ 6e-6 m, λ ≈ l0 = 1.25e-2
+        /// m); a missing geometric term T/λ would be ~1e-3 of the axial k: 1e-6 of the largest
+        /// entry separates them.
+        #[test]
+        fn tangent_matrix_matches_coloured_differences(
+            x in 0.42f64..0.62,
+            shake in 0.0f64..3e-5,
+            seed in 0u32..1000,
+            h in 1e-5f64..1e-3,
+        ) {
+            let mut s = Scenario::paper();
+            s.model.kind = ModelKind::Lumped;
+            let mut model = Lumped::new(&s).unwrap();
+            let eq = model.equilibrium(x, s.controller.tension_sum).unwrap();
+            let mut state = eq.state.clone();
+            let n = model.elements;
+            for cable in 0..2 {
+                for j in 0..n {
+                    let phase = f64::from(seed) + (cable * n + j) as f64;
+                    state[model.xi(cable, j)] += shake * (1.7 * phase).sin();
+                    if j >= model.stored[cable] {
+                        state[model.zi(cable, j)] += shake * (2.3 * phase).cos();
+                    }
+                }
+            }
+            let c_q = 0.3 * h * h;
+            let dofs = model.dofs();
+            let qdd = vec![0.0; dofs];
+            let len = model.iteration_pattern().len();
+            let (mut analytic, mut differenced) = (vec![0.0; len], vec![0.0; len]);
+            prop_assert!(model.tangent_matrix(&state, c_q, &mut analytic));
+            model.differenced_matrix(&state, &qdd, [100.0, 100.0], 0.0, c_q, &mut differenced);
+            let scale = differenced.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (i, (a, d)) in analytic.iter().zip(&differenced).enumerate() {
+                prop_assert!((a - d).abs() <= 1e-6 * scale, "entry {}: {:e} vs {:e} (scale {:e})", i, a, d, scale);
+            }
+        }
     }
 }

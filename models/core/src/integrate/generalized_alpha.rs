@@ -223,7 +223,7 @@ pub struct GeneralizedAlpha {
     matrix: Option<IterationMatrix>,
     /// Step the current factorisation was built for (0: none).
     matrix_h: f64,
-    /// What the last refresh cost in residual evaluations ([`MatrixCost::in_residuals`]), and
+    /// The last refresh's price ([`MatrixCost::refresh_price`]), and
     /// Newton iterations beyond one per step spent since (the refresh rule of
     /// [`Self::refresh_pays`]).
     refresh_cost: u64,
@@ -261,17 +261,19 @@ impl GeneralizedAlpha {
     }
 
     /// Whether to re-evaluate S before this step although it converges: once the iterations a
-    /// stale S has cost beyond one per step reach what the last refresh cost in residual
-    /// evaluations. A rent-or-buy heuristic: an iteration costs a residual and a solve, a refresh
-    /// its evaluations and a factorisation, and the counts stand in for both (no guarantee where a
-    /// fresh S itself needs more than one iteration, or where the factorisation dominates).
+    /// stale S has cost beyond one per step reach the last refresh's price
+    /// ([`MatrixCost::refresh_price`], by default its cost in residual evaluations). A
+    /// rent-or-buy heuristic: an iteration costs a residual and a solve, a refresh its
+    /// evaluations and a factorisation (no guarantee where a fresh S itself needs more than one
+    /// iteration, or where the factorisation dominates: there the model prices it).
     /// Paper runs: FE N = 10, whose fresh matrix converges in one iteration for hundreds of
     /// steps, 1.05 iterations per step with 85 refreshes (1.46 with 23 when refreshing only on
     /// slow contraction; 0.216 → 0.184 s); lumped N = 40, whose matrix ages within a step (its
     /// first free nodes sit 0.2–0.5 mm from the pulleys, transverse stiffness T/d, and the
-    /// near-horizontal springs' vertical stiffness ≈ k φ² follows the string vibrations), 2.11
-    /// iterations per step with a refresh (18 residual evaluations) every ~11 steps (2.66 and
-    /// every ~27 before the rule). Refreshing every step would not make it one: a fresh lumped
+    /// near-horizontal springs' vertical stiffness ≈ k φ² follows the string vibrations), 2.19
+    /// iterations per step with a refresh every ~18 steps (its analytic matrix priced at 50;
+    /// 2.11 and every ~11 steps when its finite-difference matrix was priced at its 18 residual
+    /// evaluations; 2.66 and every ~27 before the rule). Refreshing every step would not make it one: a fresh lumped
     /// matrix still needs 1.22 iterations per step, and one whose entries are refreshed only
     /// where they moved by more than 1e-6 relative needs 1.96: many small drifts matter, not a
     /// few large ones, so no local update of the matrix would do.
@@ -355,7 +357,7 @@ impl GeneralizedAlpha {
         let cost = sys.iteration_matrix(t, &self.y_try, &self.qdd_try, c_v, c_q, &mut self.values);
         self.stats.rhs_evals += cost.residual_evals;
         self.stats.jacobian_evals += 1;
-        self.refresh_cost = cost.in_residuals;
+        self.refresh_cost = cost.refresh_price;
         self.excess_iterations = 0;
         let matrix = self
             .matrix

@@ -15,41 +15,45 @@ pub use generalized_alpha::{
 
 /// What one evaluation of an implicit method's iteration matrix cost, in two parts kept apart:
 /// the full residual evaluations it made (counted in [`SolverStats::rhs_evals`], which MODELS.md
-/// §6 asks us to report), and its whole cost in residual evaluations, which the refresh rule
-/// weighs against Newton iterations. They differ for a matrix that is not a finite difference of
-/// the whole residual (an analytic one, or the FE model's element-local differences).
+/// §6 asks us to report), and the price the refresh rule puts on a refresh: the Newton
+/// iterations beyond one per step it lets accumulate before refreshing again. By default the
+/// price is the evaluation's cost in residual evaluations (an iteration costs a residual and a
+/// solve); a model that knows better (a refresh that buys fewer iterations than it costs, or an
+/// analytic matrix whose factorisation dominates) states its own, with its measurements.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct MatrixCost {
     /// Full residual evaluations made.
     pub residual_evals: u64,
-    /// Cost of the whole evaluation in residual evaluations (0: free, or unknown; then the
-    /// matrix is refreshed only when Newton slows).
-    pub in_residuals: u64,
+    /// The refresh rule's price of this refresh, in Newton iterations beyond one per step
+    /// (0: the matrix is refreshed only when Newton slows).
+    pub refresh_price: u64,
 }
 
 impl MatrixCost {
-    /// A matrix made of `evals` full residual evaluations (finite differences) and little else.
+    /// A matrix made of `evals` full residual evaluations (finite differences) and little else,
+    /// priced at their number.
     pub fn differences(evals: u64) -> Self {
         Self {
             residual_evals: evals,
-            in_residuals: evals,
+            refresh_price: evals,
         }
     }
 
-    /// A matrix that made no residual evaluation but costs about `in_residuals` of them.
-    pub fn equivalent(in_residuals: u64) -> Self {
+    /// A matrix that made no full residual evaluation (analytic, or element-local differences),
+    /// priced at `refresh_price`.
+    pub fn without_residuals(refresh_price: u64) -> Self {
         Self {
             residual_evals: 0,
-            in_residuals,
+            refresh_price,
         }
     }
 
     /// This cost plus `evals` full residual evaluations made on top (e.g. a column the closed
-    /// loop adds).
+    /// loop adds), each adding one to the price.
     pub fn plus_residuals(self, evals: u64) -> Self {
         Self {
             residual_evals: self.residual_evals + evals,
-            in_residuals: self.in_residuals + evals,
+            refresh_price: self.refresh_price + evals,
         }
     }
 }
