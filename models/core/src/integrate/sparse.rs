@@ -124,6 +124,13 @@ struct Layout {
     factorised: bool,
     interior_rhs: Vec<f64>,
     border_rhs: Vec<f64>,
+    /// The solve works in the factors' pivot order and scatters once at the end: per position of
+    /// that order, the unknown's index in S; per entry of C, the position of its column; and
+    /// A⁻¹B (column-major) in that order. Set after each pivoting (the first two) and each
+    /// factorisation (the last).
+    pivoted_global: Vec<usize>,
+    c_at: Vec<usize>,
+    b_pivoted: Vec<f64>,
 }
 
 /// What a solve costs: the non-zeros of L and U (one multiply-add each), the longest dependency
@@ -485,6 +492,9 @@ impl Layout {
                 factorised: false,
                 interior_rhs: vec![0.0; ni],
                 border_rhs: vec![0.0; k],
+                pivoted_global: vec![0; ni],
+                c_at: vec![0; c_col.len()],
+                b_pivoted: vec![0.0; ni * k],
             })
             .collect())
     }
@@ -540,6 +550,13 @@ impl Layout {
                 ));
             }
             self.pivots_valid = true;
+            let at = &self.factors.scatter;
+            for (&g, &s) in self.interior.iter().zip(at) {
+                self.pivoted_global[s] = g;
+            }
+            for (c, &j) in self.c_at.iter_mut().zip(&self.c_col) {
+                *c = at[j];
+            }
         }
         if k > 0 {
             // A⁻¹B in place of B, then the Schur complement D − C A⁻¹B.
@@ -564,6 +581,15 @@ impl Layout {
                     "singular Schur complement of the border".into(),
                 ));
             }
+            for (pivoted, column) in self
+                .b_pivoted
+                .chunks_exact_mut(ni)
+                .zip(self.b.chunks_exact(ni))
+            {
+                for (&s, &v) in self.factors.scatter.iter().zip(column) {
+                    pivoted[s] = v;
+                }
+            }
         }
         self.factorised = true;
         self.pivotings += u64::from(pivoted);
@@ -585,17 +611,24 @@ impl Layout {
         SolveCost::of(&self.factors, k * ni + self.c_val.len() + k * k)
     }
 
-    /// Overwrites `rhs` with S⁻¹ rhs (the last factorisation).
+    /// Overwrites `rhs` with S⁻¹ rhs (the last factorisation). In the factors' pivot order
+    /// throughout, scattered once (the same operations in the same order as in A's numbering).
     fn solve_in_place(&mut self, rhs: &mut [f64]) {
         debug_assert!(self.factorised);
         let ni = self.interior.len();
         // y = A⁻¹ r_A, gathered from the global numbering.
-        self.factors.solve(rhs, true, &mut self.interior_rhs);
+        let y = self.factors.solve_pivoted(rhs);
         let k = self.border.len();
         if k > 0 {
             // x_B = (D − C A⁻¹B)⁻¹ (r_B − C y), x_A = y − A⁻¹B x_B.
             for (b, &i) in self.border.iter().enumerate() {
-                self.border_rhs[b] = rhs[i] - self.c_row_dot(b, &self.interior_rhs);
+                let range = self.c_ptr[b]..self.c_ptr[b + 1];
+                let c_y: f64 = self.c_at[range.clone()]
+                    .iter()
+                    .zip(&self.c_val[range])
+                    .map(|(&s, c)| c * y[s])
+                    .sum();
+                self.border_rhs[b] = rhs[i] - c_y;
             }
             for (j, &i) in self.border.iter().enumerate() {
                 let x: f64 = self.schur_inverse[j * k..(j + 1) * k]
@@ -604,14 +637,14 @@ impl Layout {
                     .map(|(s, r)| s * r)
                     .sum();
                 rhs[i] = x;
-                let col = &self.b[j * ni..(j + 1) * ni];
-                for (y, a) in self.interior_rhs.iter_mut().zip(col) {
+                let col = &self.b_pivoted[j * ni..(j + 1) * ni];
+                for (y, a) in y.iter_mut().zip(col) {
                     *y -= a * x;
                 }
             }
         }
-        for (r, &i) in self.interior_rhs.iter().zip(&self.interior) {
-            rhs[i] = *r;
+        for (v, &g) in y.iter().zip(&self.pivoted_global) {
+            rhs[g] = *v;
         }
     }
 }
@@ -791,8 +824,23 @@ impl Factors {
     }
 
     /// A y = b, with b in A's own numbering or (`global`) the interior entries of a vector in
-    /// the numbering of S: the gather, L's and U's column sweeps, the scatter.
+    /// the numbering of S: the gather, L's and U's sweeps, the scatter.
     fn solve(&mut self, b: &[f64], global: bool, y: &mut [f64]) {
+        self.gather_and_sweep(b, global);
+        for (y, &s) in y.iter_mut().zip(&self.scatter) {
+            *y = self.x[s];
+        }
+    }
+
+    /// A y = b for the interior entries b of a vector in the numbering of S, with y left in the
+    /// pivot order (y_i at position `scatter[i]`) for the caller to scatter.
+    fn solve_pivoted(&mut self, b: &[f64]) -> &mut [f64] {
+        self.gather_and_sweep(b, true);
+        let n = self.u_inv_diag.len();
+        &mut self.x[..n]
+    }
+
+    fn gather_and_sweep(&mut self, b: &[f64], global: bool) {
         let gather = if global {
             &self.gather_global
         } else {
@@ -806,9 +854,6 @@ impl Factors {
             self.lanes.solve(&mut self.x);
         } else {
             self.sweep_columns();
-        }
-        for (y, &s) in y.iter_mut().zip(&self.scatter) {
-            *y = self.x[s];
         }
     }
 
