@@ -276,10 +276,10 @@ impl SecondOrderForm for Fe {
     /// its two elements; l_i: every element of its span; ρ_i: the stored element).
     fn smooth_reach(&self, state: &[f64], out: &mut [f64]) {
         out.fill(f64::INFINITY);
-        let zeros = vec![0.0; self.positions_len()];
         for block in self.blocks() {
             let (dofs, len) = self.block_dofs(block);
-            let [q, _, _] = self.gather(block, &dofs, state, &zeros);
+            // Only the positions are used: `state` stands in for q'' (no buffer to allocate).
+            let [q, _, _] = self.gather(block, &dofs, state, state);
             let limit = self.block_step_limit(block, &q);
             for dof in dofs[..len].iter().flatten() {
                 out[*dof] = out[*dof].min(limit);
