@@ -169,6 +169,41 @@ pub fn dissipation(mat: &Material, s: &ElementState, damping: f64) -> f64 {
     s.h * nd * rate
 }
 
+/// An element's chord length |Δ| = |r_b − r_a| [m] and its inverse [1/m]. Computed apart when a
+/// whole chain of elements is at hand ([`chords`]): their square roots and divisions then run two
+/// at a time, where one element after another waits on each (they were a quarter of the FE
+/// assembly).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Chord {
+    pub length: f64,
+    pub inv_length: f64,
+}
+
+impl Chord {
+    /// The chord of element `s`.
+    #[inline]
+    pub fn of(s: &ElementState) -> Self {
+        let length = (s.rb - s.ra).norm();
+        Self {
+            length,
+            inv_length: 1.0 / length,
+        }
+    }
+}
+
+/// The chords between consecutive points (x_j, z_j), (x_j+1, z_j+1) into `length` and
+/// `inv_length` (one shorter than `x` and `z`), bit for bit [`Chord::of`] of those elements.
+pub fn chords(x: &[f64], z: &[f64], length: &mut [f64], inv_length: &mut [f64]) {
+    let m = length.len();
+    let (x, z, inv_length) = (&x[..m + 1], &z[..m + 1], &mut inv_length[..m]);
+    for j in 0..m {
+        let (dx, dz) = (x[j + 1] - x[j], z[j + 1] - z[j]);
+        let l = (dx * dx + dz * dz).sqrt();
+        length[j] = l;
+        inv_length[j] = 1.0 / l;
+    }
+}
+
 /// M_e and F_e of MODELS.md FE.5.3 plus the axial damping of FE.5.7 with coefficient C =
 /// `damping` [N s]: the damping tension N_d acts along t like N_e on F_a, F_b, and adds
 /// h' N_d (1 + ε) to F_l (the virtual work −h N_d δε with δε = t·δΔ/h − (1 + ε) h' δl/h; note
@@ -180,6 +215,18 @@ pub fn terms_damped(
     s: &ElementState,
     damping: f64,
 ) -> ElementTerms {
+    terms_at_chord(mat, k, s, damping, Chord::of(s))
+}
+
+/// [`terms_damped`] with the element's chord given.
+#[inline(always)]
+pub fn terms_at_chord(
+    mat: &Material,
+    k: &MassCoefficients,
+    s: &ElementState,
+    damping: f64,
+    chord: Chord,
+) -> ElementTerms {
     debug_assert!(
         (s.h * s.inv_h - 1.0).abs() < 1e-12,
         "inv_h out of step with h"
@@ -189,11 +236,11 @@ pub fn terms_damped(
     let (a, b) = (s.va, s.vb);
     let delta = s.rb - s.ra;
     let len2 = delta.norm_squared();
-    let len = len2.sqrt();
+    let len = chord.length;
     let (strain, n) = s.tension(mat.ea, len);
     let (n_damp, _) = damping_tension(mat, s, damping);
     // (N + N_d) t with t = Δ/|Δ|: the pull on node a towards b.
-    let pull = delta * ((n + n_damp) / len);
+    let pull = delta * ((n + n_damp) * chord.inv_length);
     let h_rate = s.h_prime * ld;
     let delta_rate = b - a;
     let inv_h = s.inv_h;
@@ -247,4 +294,34 @@ pub fn energies(mat: &Material, k: &MassCoefficients, s: &ElementState) -> (f64,
     let elastic = 0.5 * mat.ea * h * strain * strain;
     let gravity = mu * mat.gravity * h * 0.5 * (s.ra.y + s.rb.y);
     (kinetic, elastic, gravity)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The chain's pass gives every element's chord bit for bit, in either direction along
+        /// the chain (the second cable's elements run against the chain's numbering).
+        #[test]
+        fn chain_chords_are_the_elements_chords(
+            points in prop::collection::vec((-1.0f64..1.0, -1.0f64..0.0), 2..24),
+        ) {
+            let (x, z): (Vec<f64>, Vec<f64>) = points.iter().copied().unzip();
+            let m = x.len() - 1;
+            let (mut length, mut inv_length) = (vec![0.0; m], vec![0.0; m]);
+            chords(&x, &z, &mut length, &mut inv_length);
+            for j in 0..m {
+                let (a, b) = (Vector2::new(x[j], z[j]), Vector2::new(x[j + 1], z[j + 1]));
+                let still = Vector2::zeros();
+                for (ra, rb) in [(a, b), (b, a)] {
+                    let s = ElementState::new((ra, still), (rb, still), 0.0, 0.1, 0.1);
+                    let chord = Chord::of(&s);
+                    prop_assert_eq!(chord.length.to_bits(), length[j].to_bits());
+                    prop_assert_eq!(chord.inv_length.to_bits(), inv_length[j].to_bits());
+                }
+            }
+        }
+    }
 }

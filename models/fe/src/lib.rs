@@ -26,7 +26,7 @@ mod statics;
 
 use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError};
 use cdpr_core::scenario::{FeMass, FeStored, Scenario};
-use element::{ElementState, MassCoefficients, Material};
+use element::{Chord, ElementState, MassCoefficients, Material};
 use nalgebra::Vector2;
 use solve::ChainSystem;
 
@@ -93,6 +93,9 @@ pub struct Fe {
     border: usize,
     /// Assembled M, F and the solve's scratch (allocated once; taken out while assembling).
     system: ChainSystem,
+    /// The chain's chords (between consecutive chain nodes) and their inverses, per assembly.
+    chord_length: Vec<f64>,
+    chord_inv_length: Vec<f64>,
 }
 
 impl Fe {
@@ -145,6 +148,8 @@ impl Fe {
             border_l: l_index,
             border,
             system: ChainSystem::new(nodes, border, l_index),
+            chord_length: vec![0.0; nodes - 1],
+            chord_inv_length: vec![0.0; nodes - 1],
         })
     }
 
@@ -279,17 +284,40 @@ impl Fe {
         ))
     }
 
+    /// Chord j of the chain from the last assembly's pass.
+    #[inline]
+    fn chord_at(&self, j: usize) -> Chord {
+        Chord {
+            length: self.chord_length[j],
+            inv_length: self.chord_inv_length[j],
+        }
+    }
+
     /// Assembles M(q) and F(q, q', T) (FE.5.3) into the block system of FE.5.5.
     fn assemble(&mut self, y: &[f64], tensions: [f64; 2]) {
         let mut sys = std::mem::take(&mut self.system);
         sys.clear();
         let n = self.elements;
         let mat = self.material;
+        let nn = self.chain_nodes();
+        element::chords(
+            &y[..nn],
+            &y[nn..2 * nn],
+            &mut self.chord_length,
+            &mut self.chord_inv_length,
+        );
         for cable in 0..2 {
             let lb = sys.l_index[cable];
             let col = 2 + 2 * cable;
             for (e, (s, k)) in (1..=n).zip(self.span(y, cable).zip(&self.coefficients)) {
-                let t = element::terms_damped(&mat, k, &s, self.axial_damping);
+                // Element e ≥ 2 joins chain nodes j, j + 1: j = e − 2 along cable 1, 2N − 1 − e
+                // along cable 2 (numbered from the other end); e = 1 starts at the pulley.
+                let chord = match (e, cable) {
+                    (1, _) => Chord::of(&s),
+                    (_, 0) => self.chord_at(e - 2),
+                    _ => self.chord_at(2 * n - 1 - e),
+                };
+                let t = element::terms_at_chord(&mat, k, &s, self.axial_damping, chord);
                 let ja = self.chain_index(cable, e - 1);
                 let jb = self.chain_index(cable, e).expect("node e ≥ 1 is free");
                 if let Some(ja) = ja {
