@@ -194,12 +194,17 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
 
     /// The effector's x: the controller feeds it back into the tension rows at the reel ends,
     /// which closes the cables' chains (reel, …, effector, …, reel) into a loop.
+    /// The model's own, and the effector's x where the controller feeds it back into the
+    /// tension rows.
     fn coupled_unknowns(&self) -> Vec<usize> {
-        self.model
-            .second_order()
-            .filter(|form| !form.tension_rows().is_empty())
-            .map(|form| vec![form.effector_x()])
-            .unwrap_or_default()
+        let Some(form) = self.model.second_order() else {
+            return Vec::new();
+        };
+        let mut coupled = form.coupled_unknowns();
+        if !form.tension_rows().is_empty() {
+            coupled.push(form.effector_x());
+        }
+        coupled
     }
 
     fn begin_step(&mut self, t: f64, y: &[f64], h: f64) {

@@ -21,6 +21,13 @@ pub trait SecondOrderForm {
     /// The (row, col) entries of ∂R/∂q'', ∂R/∂q' and ∂R/∂q that may be non-zero, for every state
     /// the model can reach (so one symbolic factorisation serves the run).
     fn iteration_pattern(&self) -> Vec<(usize, usize)>;
+    /// Coordinates that couple distant parts of [`Self::iteration_pattern`] (e.g. a length
+    /// that every node of a span depends on) without being dense enough for the sparse LU to
+    /// split them off by itself: candidates for its border (see
+    /// `cdpr_core::integrate::sparse::IterationMatrix::with_coupled`).
+    fn coupled_unknowns(&self) -> Vec<usize> {
+        Vec::new()
+    }
     /// Round-off level of max |R| [N] at `state` (0 if negligible). A force k·(q_b − q_a) from
     /// coordinates of size |q| carries k·ulp(|q|): with k = EA/l0 = 1.8e8 N/m (lumped N = 1000)
     /// that is above MODELS.md's 1e-7 N Newton tolerance, which the integrator then raises to it.

@@ -272,6 +272,12 @@ impl SecondOrderForm for Fe {
         spring_round_off(self.material.ea / shortest, &state[..self.positions_len()])
     }
 
+    /// The l_i: every node of their span depends on them (at N = 10 their 20-odd entries stay
+    /// below the sparse LU's density limit for a border of its own).
+    fn coupled_unknowns(&self) -> Vec<usize> {
+        vec![self.l_index(0), self.l_index(1)]
+    }
+
     /// Per coordinate, the smallest [`Fe::block_step_limit`] of the blocks it belongs to (a node:
     /// its two elements; l_i: every element of its span; ρ_i: the stored element).
     fn smooth_reach(&self, state: &[f64], out: &mut [f64]) {

@@ -23,8 +23,10 @@
 //! into both reels' rows and so closes the two cables' chains into a loop), the same with those
 //! unknowns in the border. The first factorisation tries every candidate and keeps the one whose
 //! factors promise the cheapest solve ([`SolveCost`]). Lumped N = 40: x in the border, both ends,
-//! 1.2 µs per solve against 2.0 µs (paper run 0.63 -> 0.55 s); FE N = 10 keeps COLAMD's order
-//! without it (the l_i already tie its chain together).
+//! 1.2 µs per solve against 2.0 µs (paper run 0.63 -> 0.55 s); FE N = 10, whose model names
+//! its span lengths l_i as coupled too (every node of a span depends on its l_i, yet at N = 10
+//! their rows stay below the density limit): l_1, l_2 and x in the border, both ends (paper
+//! run 0.158 -> 0.148 s; before the l_i were named, COLAMD's order without a border won).
 //!
 //! faer computes the factors where pivots must be chosen (fill-reducing column ordering once,
 //! Gilbert–Peierls LU with partial pivoting at the first factorisation); later factorisations
