@@ -601,11 +601,7 @@ impl Layout {
     /// Row `b` of C times the interior vector `y`.
     fn c_row_dot(&self, b: usize, y: &[f64]) -> f64 {
         let range = self.c_ptr[b]..self.c_ptr[b + 1];
-        self.c_col[range.clone()]
-            .iter()
-            .zip(&self.c_val[range])
-            .map(|(&j, c)| c * y[j])
-            .sum()
+        gathered_dot(&self.c_col[range.clone()], &self.c_val[range], y)
     }
 
     fn solve_cost(&self) -> SolveCost {
@@ -625,11 +621,7 @@ impl Layout {
             // x_B = (D − C A⁻¹B)⁻¹ (r_B − C y), x_A = y − A⁻¹B x_B.
             for (b, &i) in self.border.iter().enumerate() {
                 let range = self.c_ptr[b]..self.c_ptr[b + 1];
-                let c_y: f64 = self.c_at[range.clone()]
-                    .iter()
-                    .zip(&self.c_val[range])
-                    .map(|(&s, c)| c * y[s])
-                    .sum();
+                let c_y = gathered_dot(&self.c_at[range.clone()], &self.c_val[range], y);
                 self.border_rhs[b] = rhs[i] - c_y;
             }
             for (j, &i) in self.border.iter().enumerate() {
@@ -649,6 +641,12 @@ impl Layout {
             rhs[g] = *v;
         }
     }
+}
+
+/// Σ_k values_k x_(index_k): a sparse row (or column) times a dense vector.
+#[inline]
+fn gathered_dot(index: &[usize], values: &[f64], x: &[f64]) -> f64 {
+    index.iter().zip(values).map(|(&j, v)| v * x[j]).sum()
 }
 
 /// Smallest |pivot| a refactorisation accepts, relative to the largest entry below it in its

@@ -104,11 +104,7 @@ impl Triangle {
     #[inline]
     fn more(&self, i: usize, x: &[f64]) -> f64 {
         let range = self.more_ptr[i]..self.more_ptr[i + 1];
-        self.more_col[range.clone()]
-            .iter()
-            .zip(&self.more_val[range])
-            .map(|(&j, v)| v * x[j])
-            .sum()
+        super::gathered_dot(&self.more_col[range.clone()], &self.more_val[range], x)
     }
 }
 
