@@ -186,7 +186,7 @@ fn max_difference(a: &[f64], b: &[f64]) -> f64 {
 /// how the pulley events excite it, which shifts with every detail of the step sequence: −29 …
 /// −41.2 dB over ρ∞ = 0.85 … 0.95, h = 9e-5 … 1e-4 s and Newton variants that all meet the 1e-7 N
 /// tolerance (DP45: −26.9 dB), against the row's −40 dB. MODELS.md FE.9.3: "use h ≤ 2e-5 s if
-/// the high-frequency spectral content matters"; there the level is −24.3 dB. The row is
+/// the high-frequency spectral content matters"; there the level is −24.1 … −24.3 dB. The row is
 /// printed for the h = 1e-4 s run and asserted on this one.
 const FINE_STEP: f64 = 2e-5;
 
