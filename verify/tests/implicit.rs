@@ -263,15 +263,16 @@ fn implicit_paper_runs_meet_section_8_and_track_dormand_prince() {
         let nominal = (sim.t_final / sim.step).round() as u64;
         assert!(s.steps_accepted <= nominal + nominal / 10, "{s:?}");
         // The matrix is reused, refreshed when convergence slows or once the iterations a stale
-        // matrix costs have paid for a refresh (rent-or-buy, priced in residual evaluations).
+        // matrix costs have paid for a refresh (rent-or-buy, at the refresh's price).
         // FE's fresh matrix converges in one iteration for hundreds of steps (measured 1.05
-        // iterations per step, a refresh per 590 steps); the lumped one ages within a step, its
-        // first free nodes being 0.2–0.5 mm from the pulleys (measured 2.11 iterations per
-        // step, a refresh per 11 steps, each of 18 residual evaluations; it was every 17 steps
-        // when a refresh cost 46). The bounds on iterations leave 5 % (FE) and 14 % (lumped) for
-        // refresh timings, which move with the last bits of the trajectory; those on steps per
-        // refresh are looser (100 against 590, 5 against 11): they catch a refresh rule gone
-        // wild (a refresh every step or two), not its tuning.
+        // iterations per step, a refresh per ~560 steps); the lumped one ages within a step, its
+        // first free nodes being 0.2–0.5 mm from the pulleys (measured 2.19 iterations per
+        // step, a refresh per ~18 steps with its analytic matrix priced at 48; 2.11 and every 11
+        // steps when its differenced matrix was priced at its 18 residual evaluations). The
+        // bounds on iterations leave 5 % (FE) and 10 % (lumped) for refresh timings, which move
+        // with the last bits of the trajectory; those on steps per refresh are looser (100
+        // against ~560, 5 against ~18): they catch a refresh rule gone wild (a refresh every
+        // step or two), not its tuning.
         let iterations = s.newton_iterations as f64 / s.steps_accepted as f64;
         let (most_iterations, fewest_steps_per_refresh) = match run.kind {
             ModelKind::Lumped => (2.4, 5),
