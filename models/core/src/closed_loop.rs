@@ -192,10 +192,9 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         pattern
     }
 
-    /// The effector's x: the controller feeds it back into the tension rows at the reel ends,
-    /// which closes the cables' chains (reel, …, effector, …, reel) into a loop.
-    /// The model's own, and the effector's x where the controller feeds it back into the
-    /// tension rows.
+    /// The model's own, and the effector's x: the controller feeds it back into the tension
+    /// rows at the reel ends, which closes the cables' chains (reel, …, effector, …, reel) into
+    /// a loop.
     fn coupled_unknowns(&self) -> Vec<usize> {
         let Some(form) = self.model.second_order() else {
             return Vec::new();

@@ -45,8 +45,8 @@ pub trait SecondOrderForm {
     /// R = M(q) q'' − F(q, q', T) for state `[q | q']` into `r` (n).
     fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]);
     /// S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q at fixed tensions, in the order of
-    /// [`Self::iteration_pattern`]. Returns what it cost (residual evaluations made, and its
-    /// whole cost in them).
+    /// [`Self::iteration_pattern`]. Returns the residual evaluations it made and its refresh
+    /// price ([`MatrixCost`]).
     #[allow(clippy::too_many_arguments)]
     fn iteration_matrix(
         &mut self,

@@ -192,7 +192,8 @@ impl Chord {
 }
 
 /// The chords between consecutive points (x_j, z_j), (x_j+1, z_j+1) into `length` and
-/// `inv_length` (one shorter than `x` and `z`), bit for bit [`Chord::of`] of those elements.
+/// `inv_length` (as long as each other; `x` and `z` at least one longer: panics otherwise, a
+/// caller's sizing error), bit for bit [`Chord::of`] of those elements.
 pub fn chords(x: &[f64], z: &[f64], length: &mut [f64], inv_length: &mut [f64]) {
     let m = length.len();
     let (x, z, inv_length) = (&x[..m + 1], &z[..m + 1], &mut inv_length[..m]);

@@ -267,11 +267,12 @@ impl GeneralizedAlpha {
     /// evaluations and a factorisation (no guarantee where a fresh S itself needs more than one
     /// iteration, or where the factorisation dominates: there the model prices it).
     /// Paper runs: FE N = 10, whose fresh matrix converges in one iteration for hundreds of
-    /// steps, 1.05 iterations per step with 85 refreshes (1.46 with 23 when refreshing only on
+    /// steps, 1.05 iterations per step with ~90 refreshes (1.46 with 23 when refreshing only on
     /// slow contraction; 0.216 → 0.184 s); lumped N = 40, whose matrix ages within a step (its
     /// first free nodes sit 0.2–0.5 mm from the pulleys, transverse stiffness T/d, and the
     /// near-horizontal springs' vertical stiffness ≈ k φ² follows the string vibrations), 2.19
-    /// iterations per step with a refresh every ~18 steps (its analytic matrix priced at 50;
+    /// iterations per step with a refresh every ~18 steps (its analytic matrix priced at 48, plus 2
+    /// for the closed loop's tension column;
     /// 2.11 and every ~11 steps when its finite-difference matrix was priced at its 18 residual
     /// evaluations; 2.66 and every ~27 before the rule). Refreshing every step would not make it one: a fresh lumped
     /// matrix still needs 1.22 iterations per step, and one whose entries are refreshed only

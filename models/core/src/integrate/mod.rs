@@ -16,10 +16,12 @@ pub use generalized_alpha::{
 /// What one evaluation of an implicit method's iteration matrix cost, in two parts kept apart:
 /// the full residual evaluations it made (counted in [`SolverStats::rhs_evals`], which MODELS.md
 /// §6 asks us to report), and the price the refresh rule puts on a refresh: the Newton
-/// iterations beyond one per step it lets accumulate before refreshing again. By default the
-/// price is the evaluation's cost in residual evaluations (an iteration costs a residual and a
-/// solve); a model that knows better (a refresh that buys fewer iterations than it costs, or an
-/// analytic matrix whose factorisation dominates) states its own, with its measurements.
+/// iterations beyond one per step it lets accumulate before refreshing again. A
+/// finite-difference matrix ([`MatrixCost::differences`]) is priced at its residual evaluations
+/// (an iteration costs a residual and a solve); a model that knows better (a refresh that buys
+/// fewer iterations than it costs, or an analytic matrix whose factorisation dominates) states
+/// its own price, with its measurements. A price of 0 (the `Default`) means: refresh only when
+/// Newton slows.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct MatrixCost {
     /// Full residual evaluations made.

@@ -850,7 +850,10 @@ impl Factors {
             *x = b[g];
         }
         if self.in_lanes {
-            // The padding unknown of an odd order (if any) kept its 0.
+            // The padding unknown of an odd order (if any) must enter as 0: a solve that
+            // overflowed leaves it 0 · ∞ = NaN, which would poison every later solve.
+            let n = self.u_inv_diag.len();
+            self.x[n..].fill(0.0);
             self.lanes.solve(&mut self.x);
         } else {
             self.sweep_columns();
@@ -973,21 +976,19 @@ mod tests {
         }
     }
 
-    /// Two chains joined at one end by an "effector" e that also couples to both far ends (the
-    /// controller's feedback into the reel rows): a loop. Whichever layout the first
-    /// factorisation keeps (e in the border or not), the sweeps run from both ends at once, and
-    /// the solve matches a dense LU.
-    #[test]
-    fn loop_of_two_chains_is_swept_from_both_ends() {
-        let m = 50;
-        let (n, e) = (2 * m + 1, 2 * m);
+    /// Two chains of `m1` and `m2` unknowns (bandwidth 2 each, as x and z of a node couple to
+    /// both of the next node's) closed into a loop through one more unknown e (the last), which
+    /// reads both chains' far ends and is read by them: the lumped model's shape. Returns the
+    /// matrix and e.
+    fn loop_of_two_chains(m1: usize, m2: usize) -> (TestMatrix, usize) {
+        let e = m1 + m2;
+        let n = e + 1;
         let mut matrix = TestMatrix::new(n);
         let mut push = |r: usize, c: usize, v: f64| matrix.push(r, c, v);
         for i in 0..n {
             push(i, i, 4.0 + (i % 5) as f64);
         }
-        // Bandwidth 2 in each chain, as x and z of a node couple to both of the next node's.
-        for chain in [0..m, m..2 * m] {
+        for chain in [0..m1, m1..e] {
             for i in chain.clone() {
                 for j in [i + 1, i + 2].into_iter().filter(|j| chain.contains(j)) {
                     push(i, j, -0.5 - 0.01 * i as f64);
@@ -1002,6 +1003,44 @@ mod tests {
             push(chain.start, e, 0.05);
             push(e, chain.start, 0.04);
         }
+        (matrix, e)
+    }
+
+    /// A solve that overflows leaves non-finite values behind; with an odd interior (two chains
+    /// of 50 and 51) the paired sweeps have a padding unknown, which must not carry them into
+    /// the next solve: after a right-hand side of f64::MAX, an ordinary one must solve as a
+    /// dense LU does (1e-12, as in the loop test).
+    #[test]
+    fn an_overflowing_solve_does_not_poison_the_next() {
+        let (matrix, e) = loop_of_two_chains(50, 51);
+        let n = e + 1;
+        let mut s = IterationMatrix::with_coupled(n, &matrix.entries, &[e]).unwrap();
+        s.factorise(&matrix.values).unwrap();
+        assert!(s.solve_cost().paired && (n - s.border().len()) % 2 == 1);
+        let mut huge = vec![f64::MAX; n];
+        s.solve_in_place(&mut huge);
+        assert!(
+            huge.iter().any(|v| !v.is_finite()),
+            "the test must overflow"
+        );
+        let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
+        for (i, (x, reference)) in solved_and_dense(&mut s, &matrix.full, &rhs)
+            .into_iter()
+            .enumerate()
+        {
+            assert!((x - reference).abs() < 1e-12, "{i}: {x} vs {reference}");
+        }
+    }
+
+    /// Two chains joined at one end by an "effector" e that also couples to both far ends (the
+    /// controller's feedback into the reel rows): a loop. Whichever layout the first
+    /// factorisation keeps (e in the border or not), the sweeps run from both ends at once, and
+    /// the solve matches a dense LU.
+    #[test]
+    fn loop_of_two_chains_is_swept_from_both_ends() {
+        let m = 50;
+        let (matrix, e) = loop_of_two_chains(m, m);
+        let n = e + 1;
         let mut s = IterationMatrix::with_coupled(n, &matrix.entries, &[e]).unwrap();
         s.factorise(&matrix.values).unwrap();
         // One front along the 2m-long chain would chain about 2 × 2m unknowns through the two
