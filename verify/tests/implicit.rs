@@ -25,7 +25,8 @@ fn paper(kind: ModelKind, integrator: IntegratorKind) -> Scenario {
 /// where the path turns on that scale (the earlier ε^(1/3)·|u| ≈ 6e-6 m erred there by 3e-6 of
 /// the matrix, found when the models' own steps were limited to the smooth region); their
 /// round-off, k·ulp(1 m)/δ ≈ 1.6e-2 N/m times c_q ≤ 1e-7 s², is far below. The models' own
-/// coloured (lumped) or element-local (FE) central differences err by ~1e-10 relative, so
+/// matrices (lumped: analytic when undamped, coloured central differences when damped; FE:
+/// element-local central differences) are exact or err by ~1e-10 relative, so
 /// 1e-6 of the matrix's largest entry separates round-off from a wrong derivative (a missed
 /// term is O(c_q·EA/h) ≈ 1e-2 of it). Every entry the differences find above that threshold
 /// must lie in the declared pattern.

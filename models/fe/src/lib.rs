@@ -310,16 +310,15 @@ impl Fe {
             let lb = sys.l_index[cable];
             let col = 2 + 2 * cable;
             for (e, (s, k)) in (1..=n).zip(self.span(y, cable).zip(&self.coefficients)) {
-                // Element e ≥ 2 joins chain nodes j, j + 1: j = e − 2 along cable 1, 2N − 1 − e
-                // along cable 2 (numbered from the other end); e = 1 starts at the pulley.
-                let chord = match (e, cable) {
-                    (1, _) => Chord::of(&s),
-                    (_, 0) => self.chord_at(e - 2),
-                    _ => self.chord_at(2 * n - 1 - e),
-                };
-                let t = element::terms_at_chord(&mat, k, &s, self.axial_damping, chord);
                 let ja = self.chain_index(cable, e - 1);
                 let jb = self.chain_index(cable, e).expect("node e ≥ 1 is free");
+                // An element between chain nodes j, j + 1 has chord j of the pass; element 1
+                // starts at the pulley, which is not a chain node.
+                let chord = match ja {
+                    Some(ja) => self.chord_at(ja.min(jb)),
+                    None => Chord::of(&s),
+                };
+                let t = element::terms_at_chord(&mat, k, &s, self.axial_damping, chord);
                 if let Some(ja) = ja {
                     sys.diag[ja] += t.m_diag;
                     sys.off[ja.min(jb)] += t.m_off;

@@ -223,10 +223,9 @@ pub struct GeneralizedAlpha {
     matrix: Option<IterationMatrix>,
     /// Step the current factorisation was built for (0: none).
     matrix_h: f64,
-    /// The last refresh's price ([`MatrixCost::refresh_price`]), and
-    /// Newton iterations beyond one per step spent since (the refresh rule of
-    /// [`Self::refresh_pays`]).
-    refresh_cost: u64,
+    /// The last refresh's price ([`MatrixCost::refresh_price`]), and Newton iterations beyond
+    /// one per step spent since (the refresh rule of [`Self::refresh_pays`]).
+    refresh_price: u64,
     excess_iterations: u64,
     stats: SolverStats,
 }
@@ -254,7 +253,7 @@ impl GeneralizedAlpha {
             values: Vec::new(),
             matrix: None,
             matrix_h: 0.0,
-            refresh_cost: 0,
+            refresh_price: 0,
             excess_iterations: 0,
             stats: SolverStats::default(),
         }
@@ -271,15 +270,15 @@ impl GeneralizedAlpha {
     /// slow contraction; 0.216 → 0.184 s); lumped N = 40, whose matrix ages within a step (its
     /// first free nodes sit 0.2–0.5 mm from the pulleys, transverse stiffness T/d, and the
     /// near-horizontal springs' vertical stiffness ≈ k φ² follows the string vibrations), 2.19
-    /// iterations per step with a refresh every ~18 steps (its analytic matrix priced at 48, plus 2
-    /// for the closed loop's tension column;
-    /// 2.11 and every ~11 steps when its finite-difference matrix was priced at its 18 residual
-    /// evaluations; 2.66 and every ~27 before the rule). Refreshing every step would not make it one: a fresh lumped
-    /// matrix still needs 1.22 iterations per step, and one whose entries are refreshed only
+    /// iterations per step with a refresh every ~18 steps (its analytic matrix priced at 48,
+    /// plus 2 for the closed loop's tension column; 2.11 and every ~11 steps when its
+    /// finite-difference matrix was priced at its 18 residual evaluations; 2.66 and every ~27
+    /// before the rule). Refreshing every step would not make it one: a fresh lumped matrix
+    /// still needs 1.22 iterations per step, and one whose entries are refreshed only
     /// where they moved by more than 1e-6 relative needs 1.96: many small drifts matter, not a
     /// few large ones, so no local update of the matrix would do.
     fn refresh_pays(&self) -> bool {
-        self.refresh_cost > 0 && self.excess_iterations >= self.refresh_cost
+        self.refresh_price > 0 && self.excess_iterations >= self.refresh_price
     }
 
     /// Counters so far.
@@ -358,7 +357,7 @@ impl GeneralizedAlpha {
         let cost = sys.iteration_matrix(t, &self.y_try, &self.qdd_try, c_v, c_q, &mut self.values);
         self.stats.rhs_evals += cost.residual_evals;
         self.stats.jacobian_evals += 1;
-        self.refresh_cost = cost.refresh_price;
+        self.refresh_price = cost.refresh_price;
         self.excess_iterations = 0;
         let matrix = self
             .matrix
@@ -512,7 +511,7 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
         }
         let pattern = sys.iteration_pattern();
         self.values = vec![0.0; pattern.len()];
-        (self.refresh_cost, self.excess_iterations) = (0, 0);
+        (self.refresh_price, self.excess_iterations) = (0, 0);
         self.matrix = Some(IterationMatrix::with_coupled(
             n,
             &pattern,

@@ -100,8 +100,8 @@ struct Layout {
     pattern: SymbolicSparseColMat<usize>,
     slot: Vec<Slot>,
     values: Vec<f64>,
-    /// B (interior × k, column-major), overwritten by A⁻¹B at each factorisation; C (k × interior)
-    /// by compressed rows, as it has only the few entries of the pattern (a coupled unknown's row:
+    /// B (interior × k, column-major; A⁻¹B goes to `b_pivoted`); C (k × interior) by compressed
+    /// rows, as it has only the few entries of the pattern (a coupled unknown's row:
     /// its neighbours); D (k × k).
     b: Vec<f64>,
     c_ptr: Vec<usize>,
@@ -124,12 +124,11 @@ struct Layout {
     /// Factorisations that pivoted (faer's), of all since the start.
     pivotings: u64,
     factorised: bool,
-    interior_rhs: Vec<f64>,
     border_rhs: Vec<f64>,
     /// The solve works in the factors' pivot order and scatters once at the end: per position of
     /// that order, the unknown's index in S; per entry of C, the position of its column; and
     /// A⁻¹B (column-major) in that order. Set after each pivoting (the first two) and each
-    /// factorisation (the last).
+    /// factorisation (the last; B itself stays in A's numbering, where it is assembled).
     pivoted_global: Vec<usize>,
     c_at: Vec<usize>,
     b_pivoted: Vec<f64>,
@@ -492,7 +491,6 @@ impl Layout {
                 pivots_valid: false,
                 pivotings: 0,
                 factorised: false,
-                interior_rhs: vec![0.0; ni],
                 border_rhs: vec![0.0; k],
                 pivoted_global: vec![0; ni],
                 c_at: vec![0; c_col.len()],
@@ -561,15 +559,21 @@ impl Layout {
             }
         }
         if k > 0 {
-            // A⁻¹B in place of B, then the Schur complement D − C A⁻¹B.
-            for column in self.b.chunks_exact_mut(ni) {
-                self.interior_rhs.copy_from_slice(column);
-                self.factors.solve(&self.interior_rhs, false, column);
+            // A⁻¹B in the factors' pivot order (as the solve uses it), then the Schur
+            // complement D − C A⁻¹B.
+            for (pivoted, column) in self
+                .b_pivoted
+                .chunks_exact_mut(ni)
+                .zip(self.b.chunks_exact(ni))
+            {
+                pivoted.copy_from_slice(self.factors.solve_pivoted(column, false));
             }
             let mut schur = self.d.clone();
             for i in 0..k {
+                let range = self.c_ptr[i]..self.c_ptr[i + 1];
+                let (at, c) = (&self.c_at[range.clone()], &self.c_val[range]);
                 for j in 0..k {
-                    schur[(i, j)] -= self.c_row_dot(i, &self.b[j * ni..(j + 1) * ni]);
+                    schur[(i, j)] -= gathered_dot(at, c, &self.b_pivoted[j * ni..(j + 1) * ni]);
                 }
             }
             let inverse = schur.partial_piv_lu().inverse();
@@ -583,25 +587,10 @@ impl Layout {
                     "singular Schur complement of the border".into(),
                 ));
             }
-            for (pivoted, column) in self
-                .b_pivoted
-                .chunks_exact_mut(ni)
-                .zip(self.b.chunks_exact(ni))
-            {
-                for (&s, &v) in self.factors.scatter.iter().zip(column) {
-                    pivoted[s] = v;
-                }
-            }
         }
         self.factorised = true;
         self.pivotings += u64::from(pivoted);
         Ok(())
-    }
-
-    /// Row `b` of C times the interior vector `y`.
-    fn c_row_dot(&self, b: usize, y: &[f64]) -> f64 {
-        let range = self.c_ptr[b]..self.c_ptr[b + 1];
-        gathered_dot(&self.c_col[range.clone()], &self.c_val[range], y)
     }
 
     fn solve_cost(&self) -> SolveCost {
@@ -615,7 +604,7 @@ impl Layout {
         debug_assert!(self.factorised);
         let ni = self.interior.len();
         // y = A⁻¹ r_A, gathered from the global numbering.
-        let y = self.factors.solve_pivoted(rhs);
+        let y = self.factors.solve_pivoted(rhs, true);
         let k = self.border.len();
         if k > 0 {
             // x_B = (D − C A⁻¹B)⁻¹ (r_B − C y), x_A = y − A⁻¹B x_B.
@@ -824,23 +813,9 @@ impl Factors {
     }
 
     /// A y = b, with b in A's own numbering or (`global`) the interior entries of a vector in
-    /// the numbering of S: the gather, L's and U's sweeps, the scatter.
-    fn solve(&mut self, b: &[f64], global: bool, y: &mut [f64]) {
-        self.gather_and_sweep(b, global);
-        for (y, &s) in y.iter_mut().zip(&self.scatter) {
-            *y = self.x[s];
-        }
-    }
-
-    /// A y = b for the interior entries b of a vector in the numbering of S, with y left in the
-    /// pivot order (y_i at position `scatter[i]`) for the caller to scatter.
-    fn solve_pivoted(&mut self, b: &[f64]) -> &mut [f64] {
-        self.gather_and_sweep(b, true);
-        let n = self.u_inv_diag.len();
-        &mut self.x[..n]
-    }
-
-    fn gather_and_sweep(&mut self, b: &[f64], global: bool) {
+    /// the numbering of S: the gather, then L's and U's sweeps. y is left in the pivot order
+    /// (y_i at position `scatter[i]`) for the caller to scatter.
+    fn solve_pivoted(&mut self, b: &[f64], global: bool) -> &mut [f64] {
         let gather = if global {
             &self.gather_global
         } else {
@@ -858,6 +833,8 @@ impl Factors {
         } else {
             self.sweep_columns();
         }
+        let n = self.u_inv_diag.len();
+        &mut self.x[..n]
     }
 
     /// x ← U⁻¹ L⁻¹ x by columns.
