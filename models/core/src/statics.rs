@@ -43,6 +43,14 @@ pub trait StaticProblem {
         0.0
     }
 
+    /// The largest fraction (≤ 1) of the Newton step `delta` from `unknowns` that keeps the
+    /// residual smooth along it, where the problem has kinks (a cable bending over a point
+    /// pulley): Newton's linear model knows nothing beyond a kink and can jump onto it, where no
+    /// Jacobian steers. Default 1 (smooth everywhere).
+    fn step_limit(&mut self, _unknowns: &[f64], _delta: &[f64]) -> f64 {
+        1.0
+    }
+
     /// ∂R/∂u at `unknowns` in the order of [`Self::pattern`], where the problem computes it
     /// itself; false: coloured differences do. Why: a dense row needs one colour per unknown it
     /// touches (the FE model's l rows: O(n²) per Jacobian, 2.7 s at N = 1000), while the
@@ -285,7 +293,7 @@ pub fn solve<P: StaticProblem>(
         // the tolerance, where round-off makes "decrease" meaningless). Near the solution the full
         // step is always taken, so quadratic convergence and the solution are unchanged.
         let norm = norm2(&r);
-        let mut lambda = 1.0;
+        let mut lambda = problem.step_limit(unknowns, &delta).clamp(0.0, 1.0);
         let mut accepted = false;
         for _ in 0..MAX_HALVINGS {
             for i in 0..n {
@@ -411,5 +419,63 @@ mod tests {
             "{u:?}"
         );
         assert!(report.iterations < 12, "{report:?}");
+    }
+
+    /// R(u) = u + 1, root −1, with a step limit that keeps 1/10 of the distance to u = 0 (as a
+    /// node keeps to its side of a pulley's kink). Without the limit one Newton step from u = 1
+    /// lands on the root; with it the solver must never evaluate at u ≤ 0 and must end in an
+    /// error near u = 0, not at the root across the boundary.
+    struct Bounded {
+        limited: bool,
+        evaluated: Vec<f64>,
+    }
+    impl StaticProblem for Bounded {
+        fn dimension(&self) -> usize {
+            1
+        }
+        fn length_unknowns(&self) -> usize {
+            1
+        }
+        fn residual(&mut self, u: &[f64], r: &mut [f64]) {
+            self.evaluated.push(u[0]);
+            r[0] = u[0] + 1.0;
+        }
+        /// Exact, so that every evaluation is an iterate or a line-search trial.
+        fn pattern(&self) -> Option<Vec<(usize, usize)>> {
+            Some(vec![(0, 0)])
+        }
+        fn jacobian(&mut self, _u: &[f64], values: &mut [f64]) -> bool {
+            values[0] = 1.0;
+            true
+        }
+        fn step_limit(&mut self, u: &[f64], delta: &[f64]) -> f64 {
+            if self.limited && -delta[0] > 0.9 * u[0] {
+                0.9 * u[0] / -delta[0]
+            } else {
+                1.0
+            }
+        }
+    }
+
+    #[test]
+    fn step_limit_keeps_every_iterate_on_its_side() {
+        let mut free = Bounded {
+            limited: false,
+            evaluated: Vec::new(),
+        };
+        let mut u = [1.0];
+        solve(&mut free, &mut u, NewtonOptions::default()).unwrap();
+        assert_eq!(u[0], -1.0);
+
+        let mut bounded = Bounded {
+            limited: true,
+            evaluated: Vec::new(),
+        };
+        let mut u = [1.0];
+        assert!(solve(&mut bounded, &mut u, NewtonOptions::default()).is_err());
+        assert!(bounded.evaluated.iter().all(|&v| v > 0.0));
+        // Each step keeps 1/10 of the distance, until the residual's change (u itself) drops
+        // below ulp(1) and the line search stops: u ≈ 1e-16.
+        assert!(u[0] > 0.0 && u[0] < 1e-12, "u = {}", u[0]);
     }
 }
