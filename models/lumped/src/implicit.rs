@@ -71,7 +71,7 @@ impl Lumped {
     /// slack spring adds nothing; a stored node's z row is its mass alone (MODELS.md §4: the
     /// constraint holds it on z = 0). False (values unusable) where a straddling end sits exactly
     /// at its pulley (no direction there).
-    fn tangent_matrix(&self, state: &[f64], c_q: f64, values: &mut [f64]) -> bool {
+    pub(crate) fn tangent_matrix(&self, state: &[f64], c_q: f64, values: &mut [f64]) -> bool {
         let n = self.elements;
         values.fill(0.0);
         for cable in 0..2 {

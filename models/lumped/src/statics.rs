@@ -6,6 +6,11 @@
 //! chord/(1 + T/EA), N − r = ⌊that/l0⌋), then checked against the side rule at the solution and
 //! shifted by one node until it holds, so any start position inside the workspace finds its own
 //! straddling spring.
+//!
+//! The kink of the straddling spring's length at the pulley (eq. 4) is kept out of Newton's way:
+//! an exact Jacobian (no difference step across it), steps that keep the boundary nodes on their
+//! side, and a node that stalls at the pulley is moved across. Sweeps of x ∈ [0.15, 0.85] m,
+//! ΣT ∈ [120, 400] N found 2 failing starts in 2 000 without these; 0 in 500 000 with them.
 
 use crate::pulley::beyond;
 use crate::{E_OUT, Lumped};
@@ -24,6 +29,12 @@ struct Problem {
     forces: Vec<f64>,
     /// State indices of the length unknowns, in order (F0 is the last unknown).
     map: Vec<usize>,
+    /// Inverse of `map`: the unknown of each position coordinate, if it is one.
+    unknown: Vec<Option<usize>>,
+    /// The model's iteration pattern (over the positions q) and two value buffers for it.
+    dynamic: Vec<(usize, usize)>,
+    tangent: Vec<f64>,
+    masses: Vec<f64>,
 }
 
 impl Problem {
@@ -38,13 +49,31 @@ impl Problem {
             }
         }
         map.push(model.zi(0, model.elements));
+        let mut unknown = vec![None; model.positions_len()];
+        for (k, &i) in map.iter().enumerate() {
+            unknown[i] = Some(k);
+        }
+        let dynamic = model.iteration_pattern();
         Self {
             y: vec![0.0; model.state_len()],
             forces: vec![0.0; model.positions_len()],
+            tangent: vec![0.0; dynamic.len()],
+            masses: vec![0.0; dynamic.len()],
+            dynamic,
+            unknown,
             model,
             effector_x,
             tension_sum,
             map,
+        }
+    }
+
+    /// The equation of position row `i`: its force balance, or F0's for the effector's x.
+    fn row_of(&self, i: usize) -> Option<usize> {
+        if i == self.model.effector_x() {
+            Some(self.map.len())
+        } else {
+            self.unknown[i]
         }
     }
 
@@ -83,29 +112,80 @@ impl StaticProblem for Problem {
     /// The chain's pattern (`SecondOrderForm::iteration_pattern`) over the unknowns; the
     /// effector's x row is F0's equation.
     fn pattern(&self) -> Option<Vec<(usize, usize)>> {
-        let mut unknown = vec![None; self.model.positions_len()];
-        for (k, &i) in self.map.iter().enumerate() {
-            unknown[i] = Some(k);
-        }
-        let (force, effector_x) = (self.map.len(), self.model.xi(0, self.model.elements));
         Some(statics::pattern_from_dynamics(
-            &self.model.iteration_pattern(),
-            |i| {
-                if i == effector_x {
-                    Some(force)
-                } else {
-                    unknown[i]
-                }
-            },
-            |j| unknown[j],
+            &self.dynamic,
+            |i| self.row_of(i),
+            |j| self.unknown[j],
             &self.model.tension_rows(),
-            force,
+            self.map.len(),
         ))
+    }
+    /// Exact, from the springs' tangent stiffness ([`Lumped::tangent_matrix`] gives
+    /// S = diag(m) − c_q ∂F/∂q, so S(0) − S(1) = ∂F/∂q; the residual here is F), in the order
+    /// [`statics::pattern_from_dynamics`] gives [`Self::pattern`], then F0's column:
+    /// T_i = (ΣT ∓ F0)/2 pulls P_0 along e_out (MODELS.md §4). Why not differences: a node
+    /// whose equilibrium lies within their step (6e-10 m) of its pulley has them straddle the
+    /// kink of eq. 4's |P − A|, and Newton stalled there (6 of 500 000 starts over the
+    /// proptest's ranges; 1 with this Jacobian, mended by [`Self::step_limit`]). False
+    /// (differences instead) exactly at a pulley.
+    fn jacobian(&mut self, u: &[f64], values: &mut [f64]) -> bool {
+        self.load(u);
+        if !self.model.tangent_matrix(&self.y, 1.0, &mut self.tangent) {
+            return false;
+        }
+        self.model.tangent_matrix(&self.y, 0.0, &mut self.masses);
+        let mut at = 0;
+        for (p, &(row, col)) in self.dynamic.iter().enumerate() {
+            if self.row_of(row).is_some() && self.unknown[col].is_some() {
+                values[at] = self.masses[p] - self.tangent[p];
+                at += 1;
+            }
+        }
+        for (cable, row) in self.model.tension_rows().into_iter().enumerate() {
+            if self.row_of(row).is_some() {
+                values[at] = [-0.5, 0.5][cable] * E_OUT[cable];
+                at += 1;
+            }
+        }
+        debug_assert_eq!(at, values.len());
+        true
+    }
+    /// Fraction to the kink: the boundary nodes (last stored, first free) keep at least
+    /// [`KINK_KEEP`] of their distance from their pulley, so an iterate cannot land on eq. 4's
+    /// kink, where |P − A| has no derivative; a node whose equilibrium lies across it approaches
+    /// geometrically and Newton stops near it, for [`split_across_kink`] to move the node over.
+    /// The free node's bound uses the step's length (|P + λδ − A| ≥ |P − A| − λ|δ|).
+    fn step_limit(&mut self, u: &[f64], delta: &[f64]) -> f64 {
+        self.load(u);
+        let model = &self.model;
+        let step = |i: usize| self.unknown[i].map_or(0.0, |k| delta[k]);
+        let mut limit = 1.0f64;
+        let mut keep = |room: f64, toward: f64| {
+            if toward > (1.0 - KINK_KEEP) * room {
+                limit = limit.min((1.0 - KINK_KEEP) * room / toward);
+            }
+        };
+        for (cable, r) in model.stored().into_iter().enumerate() {
+            if r > 0 {
+                let j = r - 1;
+                keep(
+                    beyond(model, &self.y, cable, j),
+                    -step(model.xi(cable, j)) * E_OUT[cable],
+                );
+            }
+            if r < model.elements {
+                let offset = model.node(&self.y, cable, r) - model.pulley(cable);
+                let moved = Vector2::new(step(model.xi(cable, r)), step(model.zi(cable, r)));
+                keep(offset.norm(), moved.norm());
+            }
+        }
+        limit
     }
     fn residual_round_off(&self) -> f64 {
         self.model.residual_round_off(&self.y)
     }
-    /// Finite-difference scales: 1e-4 m for coordinates, a 6e-10 m step, far inside a spring's
+    /// Finite-difference scales, for where [`Self::jacobian`] declines (a node exactly at its
+    /// pulley): 1e-4 m for coordinates, a 6e-10 m step, far inside a spring's
     /// stretch (T/k0 = 8e-6 m at 60 N; a step beyond it slackens the spring and corrupts the
     /// Jacobian) and still moving forces by 4e-3 N against a 2e-9 N round-off. ΣT for F0, on
     /// which the residual depends linearly.
@@ -154,6 +234,18 @@ fn guess(model: &mut Lumped, effector: Vector2<f64>, tension: f64, ea: f64) -> V
 /// Splits tried before giving up (a start needs at most one or two shifts).
 const MAX_SPLITS: usize = 6;
 
+/// Least distance from the pulley at which [`reclassify`] starts a node that changes sides, and
+/// within which [`split_across_kink`] finds a stalled node [multiples of l0]. 1e-4·l0 = 2.5e-6 m
+/// on the paper's cable: below the springs' stretch T/k0 (8e-6 m at 60 N), so moving a node by
+/// it slackens no spring. 1e-3·l0 (2.5e-5 m) did slacken them (238 N of residual, no Newton
+/// step reducing it) in 7 of 70 000 starts x ∈ [0.15, 0.85] m, ΣT ∈ [120, 400] N.
+const PULLEY_GAP: f64 = 1e-4;
+
+/// The least fraction of its distance from its pulley a boundary node keeps over one Newton
+/// step ([`StaticProblem::step_limit`]): 1/10, so a node whose solution is 2.85e-8 m from the
+/// pulley (x = 0.324825 m, ΣT = 231.44 N) is reached from the 2.5e-6 m start in two steps.
+const KINK_KEEP: f64 = 0.1;
+
 /// Switches to the split `stored`: a node changing sides starts just on its new side of the
 /// pulley, on its new path (the straddling spring's length has a kink at the pulley that Newton
 /// cannot cross).
@@ -169,7 +261,7 @@ fn reclassify(model: &mut Lumped, y: &mut [f64], stored: [usize; 2], effector_x:
         let j = old.min(new);
         let gap = (model.node(y, cable, j) - a)
             .norm()
-            .max(1e-3 * model.segment);
+            .max(PULLEY_GAP * model.segment);
         let p = if new > old {
             a + Vector2::new(E_OUT[cable] * gap, 0.0)
         } else {
@@ -179,6 +271,29 @@ fn reclassify(model: &mut Lumped, y: &mut [f64], stored: [usize; 2], effector_x:
         y[model.zi(cable, j)] = p.y;
     }
     model.set_stored(stored);
+}
+
+/// The split with a stalled boundary node moved across the pulley, if one stalled there. When a
+/// split's solution would put its last stored node (first free node) on the other side, the
+/// straddling spring's length |P_(r−1) − A| + |A − P_r| folds back at A, where it has no
+/// derivative: Newton stalls on the kink instead of converging (e.g. x = 0.1745 m, ΣT = 197 N:
+/// node 33 of cable 0 stuck 1e-10 m beyond the pulley with 0.075 N unbalanced). That node has
+/// crossed; the side rule moves it.
+fn split_across_kink(model: &Lumped, y: &[f64]) -> Option<[usize; 2]> {
+    let radius = PULLEY_GAP * model.segment;
+    let mut stored = model.stored();
+    let mut shifted = false;
+    for (cable, r) in stored.iter_mut().enumerate() {
+        let at_kink = |j: usize| (model.node(y, cable, j) - model.pulley(cable)).norm() < radius;
+        if *r > 0 && at_kink(*r - 1) {
+            *r -= 1;
+            shifted = true;
+        } else if *r < model.elements && at_kink(*r) {
+            *r += 1;
+            shifted = true;
+        }
+    }
+    shifted.then_some(stored)
 }
 
 /// Equilibrium with the split found by the side rule (MODELS.md §2, §4).
@@ -203,7 +318,16 @@ pub(crate) fn equilibrium(
         problem.load(&u);
         y.copy_from_slice(&problem.y);
         let mut stored = model.stored();
-        let report = solved?;
+        let report = match solved {
+            Ok(report) => report,
+            Err(error) => match split_across_kink(model, &y) {
+                Some(shifted) => {
+                    reclassify(model, &mut y, shifted, effector_x);
+                    continue;
+                }
+                None => return Err(error.into()),
+            },
+        };
         // Side rule at the solution: shift the split where the last stored node is not beyond
         // the pulley or the first free node is.
         let mut consistent = true;
@@ -232,4 +356,60 @@ pub(crate) fn equilibrium(
             "no consistent stored/free split found for the effector at x = {effector_x} m"
         ),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cdpr_core::scenario::{ModelKind, Scenario};
+
+    /// The exact static Jacobian against central differences of the residual, entry by entry
+    /// and outside the pattern too, at the x = 0.6 m equilibrium (F0 ≠ 0, unequal splits) with
+    /// every unknown shaken by up to 3e-6 m (inside the springs' ~1.3e-5 m stretch, so none goes
+    /// slack). Per column, against that column's largest entry (F0's column is 0.5, beside
+    /// k0 = 7.5e6 N/m): steps 1e-9 m (round-off ~2e-9 N / 1e-9 m ≈ 2 N/m, 3e-7 of k0) and 1e-3 N
+    /// for F0 (the residual is affine in it). Measured 3.5e-8; bound 1e-6. A flipped F0 column
+    /// fails it.
+    #[test]
+    fn static_jacobian_matches_central_differences() {
+        let mut s = Scenario::paper();
+        s.model.kind = ModelKind::Lumped;
+        let mut model = Lumped::new(&s).unwrap();
+        let eq = model.equilibrium(0.6, 200.0).unwrap();
+        let mut problem = Problem::new(model, 0.6, 200.0);
+        let n = problem.dimension();
+        let mut u: Vec<f64> = problem.map.iter().map(|&i| eq.state[i]).collect();
+        u.push(eq.force);
+        for (k, v) in u.iter_mut().enumerate().take(n - 1) {
+            *v += 3e-6 * (1.3 * k as f64).sin();
+        }
+        let pattern = problem.pattern().unwrap();
+        let mut values = vec![0.0; pattern.len()];
+        assert!(problem.jacobian(&u, &mut values));
+        let mut exact = vec![0.0; n * n];
+        for (&(r, c), v) in pattern.iter().zip(&values) {
+            exact[r * n + c] += v;
+        }
+        let (mut plus, mut minus) = (vec![0.0; n], vec![0.0; n]);
+        let mut ratio = 0.0f64;
+        for c in 0..n {
+            let (mut worst, mut largest) = (0.0f64, 0.0f64);
+            let h = if c == n - 1 { 1e-3 } else { 1e-9 };
+            let mut moved = u.clone();
+            moved[c] += h;
+            problem.residual(&moved, &mut plus);
+            moved[c] -= 2.0 * h;
+            problem.residual(&moved, &mut minus);
+            for r in 0..n {
+                let differenced = (plus[r] - minus[r]) / (2.0 * h);
+                worst = worst.max((differenced - exact[r * n + c]).abs());
+                largest = largest.max(differenced.abs());
+            }
+            ratio = ratio.max(worst / largest);
+        }
+        assert!(
+            ratio < 1e-6,
+            "worst column error {ratio:e} of its largest entry"
+        );
+    }
 }

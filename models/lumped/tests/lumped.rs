@@ -4,7 +4,7 @@
 
 use cdpr_core::closed_loop::{Actuation, ClosedLoop, RunOptions, simulate, simulate_from};
 use cdpr_core::integrate::{Dopri5, Dopri5Options, OdeSystem};
-use cdpr_core::model::CableModel;
+use cdpr_core::model::{CableModel, Equilibrium};
 use cdpr_core::scenario::{ModelKind, Scenario};
 use cdpr_lumped::{E_OUT, Lumped};
 use proptest::prelude::*;
@@ -62,6 +62,57 @@ fn equilibrium_matches_the_independent_solution() {
     assert!((eq.force - 0.097531).abs() < 5e-7, "F0 = {}", eq.force);
 }
 
+/// The largest force on any coordinate at `eq` under its commanded tensions [N] (node masses
+/// folded back in).
+fn largest_force(m: &mut Lumped, eq: &Equilibrium, tension_sum: f64) -> f64 {
+    let mut rate = vec![0.0; m.state_len()];
+    m.rhs(0.0, &eq.state, tensions(tension_sum, eq.force), &mut rate);
+    let np = m.positions_len();
+    (0..np)
+        .map(|i| {
+            let mass = if i >= 4 * m.elements {
+                1.0
+            } else {
+                m.node_mass
+            };
+            (rate[np + i] * mass).abs()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Starts whose equilibrium puts a node within microns of a pulley, where eq. 4's straddling
+/// length |P − A| has its kink: found by sweeping the proptest's ranges (700 × 100 and
+/// 2000 × 250 grids) after CI hit the first. What each one broke:
+/// - (0.1745, 197), (0.8255, 197): Newton stalled 1e-10 m beyond the pulley, 0.075 N unbalanced,
+///   and the error was returned instead of moving the node across;
+/// - (0.1735, 121.4), (0.4255, 163.4), (0.6005, 197), (0.7015, 132.6): the node moved across
+///   started 2.5e-5 m from the pulley, which slackened its neighbours' springs (238 N residual);
+/// - (0.324825, 231.44), (0.675175, 231.44): the solution's node is 2.85e-8 m from the pulley,
+///   inside the finite-difference step, and an unlimited step landed on the kink (5.6e-21 m).
+///
+/// Same criteria as the proptest below.
+#[test]
+fn equilibrium_beside_a_pulley_obeys_the_side_rule() {
+    for (x, tension_sum) in [
+        (0.1745, 197.0),
+        (0.8255, 197.0),
+        (0.1735, 121.4),
+        (0.4255, 163.4),
+        (0.6005, 197.0),
+        (0.7015, 132.6),
+        (0.324825, 231.44),
+        (0.675175, 231.44),
+    ] {
+        let mut m = Lumped::new(&paper()).unwrap();
+        let eq = m
+            .equilibrium(x, tension_sum)
+            .unwrap_or_else(|e| panic!("x = {x} m, ΣT = {tension_sum} N: {e}"));
+        assert!(side_rule_holds(&m, &eq.state), "stored {:?}", m.stored());
+        let worst = largest_force(&mut m, &eq, tension_sum);
+        assert!(worst < 1e-7, "x = {x} m: largest force {worst:e} N");
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(16))]
 
@@ -73,15 +124,7 @@ proptest! {
         let mut m = Lumped::new(&paper()).unwrap();
         let eq = m.equilibrium(x, tension_sum).unwrap();
         prop_assert!(side_rule_holds(&m, &eq.state), "stored {:?}", m.stored());
-        let mut rate = vec![0.0; m.state_len()];
-        m.rhs(0.0, &eq.state, tensions(tension_sum, eq.force), &mut rate);
-        let np = m.positions_len();
-        let worst = (0..np)
-            .map(|i| {
-                let mass = if i >= 4 * m.elements { 1.0 } else { m.node_mass };
-                (rate[np + i] * mass).abs()
-            })
-            .fold(0.0, f64::max);
+        let worst = largest_force(&mut m, &eq, tension_sum);
         prop_assert!(worst < 1e-7, "largest force {worst:e} N");
     }
 }
