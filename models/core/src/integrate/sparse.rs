@@ -32,7 +32,7 @@
 //! Gilbert–Peierls LU with partial pivoting at the first factorisation); later factorisations
 //! reuse that pivot sequence and recompute only the numbers on the known pattern ([`Factors`],
 //! as KLU's refactor), and pivot afresh through faer only when a reused pivot falls below a tenth
-//! of its column. Lumped N = 40 paper run: 2 of 2 843 factorisations pivot; reusing the pivots took
+//! of its column. Lumped N = 40 paper run: 2 of 2 855 factorisations pivot; reusing the pivots took
 //! the run 0.50 -> 0.45 s (one sample per step). faer 0.24 has no such numeric-only path. The solve,
 //! which runs once per Newton iteration, sweeps the factors by columns itself: U's diagonal
 //! inverted once per factorisation instead of divided at every solve, the permutations folded
