@@ -252,7 +252,7 @@ fn max_abs(v: &[f64]) -> f64 {
 /// Solves R(u) = 0 from the guess in `unknowns` (overwritten with the solution), with a central
 /// finite-difference Jacobian (step ε^(1/3)·[`StaticProblem::scale`]), a dense LU (faer) or,
 /// where the problem declares its [`StaticProblem::pattern`], coloured differences and a sparse
-/// LU, and a backtracking line search. The Jacobian only steers the iteration; the solution's accuracy is
+/// LU, and a backtracking line search from [`StaticProblem::step_limit`]. The Jacobian only steers the iteration; the solution's accuracy is
 /// set by the residual alone.
 pub fn solve<P: StaticProblem>(
     problem: &mut P,
@@ -289,9 +289,10 @@ pub fn solve<P: StaticProblem>(
         if !linear.newton_step(problem, unknowns, &mut delta) {
             return Err(NewtonError::Singular { iteration });
         }
-        // Backtracking: halve the step until the residual's 2-norm decreases (or is already below
-        // the tolerance, where round-off makes "decrease" meaningless). Near the solution the full
-        // step is always taken, so quadratic convergence and the solution are unchanged.
+        // Backtracking from the problem's step limit: halve the step until the residual's 2-norm
+        // decreases (or is already below the tolerance, where round-off makes "decrease"
+        // meaningless). Near the solution the full step is taken (unless the limit cuts it), so
+        // quadratic convergence and the solution are unchanged.
         let norm = norm2(&r);
         let mut lambda = problem.step_limit(unknowns, &delta).clamp(0.0, 1.0);
         let mut accepted = false;

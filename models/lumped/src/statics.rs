@@ -10,7 +10,8 @@
 //! The kink of the straddling spring's length at the pulley (eq. 4) is kept out of Newton's way:
 //! an exact Jacobian (no difference step across it), steps that keep the boundary nodes on their
 //! side, and a node that stalls at the pulley is moved across. Sweeps of x ∈ [0.15, 0.85] m,
-//! ΣT ∈ [120, 400] N found 2 failing starts in 2 000 without these; 0 in 500 000 with them.
+//! ΣT ∈ [120, 400] N found 2 failing starts in 2 000 without any of these; 0 in 500 000 with
+//! all of them (the docs of each say what removing it alone brings back).
 
 use crate::pulley::beyond;
 use crate::{E_OUT, Lumped};
@@ -123,11 +124,14 @@ impl StaticProblem for Problem {
     /// Exact, from the springs' tangent stiffness ([`Lumped::tangent_matrix`] gives
     /// S = diag(m) − c_q ∂F/∂q, so S(0) − S(1) = ∂F/∂q; the residual here is F), in the order
     /// [`statics::pattern_from_dynamics`] gives [`Self::pattern`], then F0's column:
-    /// T_i = (ΣT ∓ F0)/2 pulls P_0 along e_out (MODELS.md §4). Why not differences: a node
-    /// whose equilibrium lies within their step (6e-10 m) of its pulley has them straddle the
-    /// kink of eq. 4's |P − A|, and Newton stalled there (6 of 500 000 starts over the
-    /// proptest's ranges; 1 with this Jacobian, mended by [`Self::step_limit`]). False
-    /// (differences instead) exactly at a pulley.
+    /// T_i = (ΣT ∓ F0)/2 pulls P_0 along e_out (MODELS.md §4). Why not differences: an iterate
+    /// whose boundary node comes within their step (6e-10 m) of its pulley has them straddle
+    /// the kink of eq. 4's |P − A|, and Newton stalled there (6 of 500 000 starts over the
+    /// proptest's ranges, with the other mends in place; 1 with this Jacobian, mended by
+    /// [`Self::step_limit`]). The tangent stiffness itself is checked against differences over
+    /// shaken equilibria, straddling spring included, in `implicit.rs`. False
+    /// (differences instead) exactly at a pulley. Exact for damped cables too: at rest every
+    /// λ' = 0, so the Kelvin–Voigt term and its position derivative vanish.
     fn jacobian(&mut self, u: &[f64], values: &mut [f64]) -> bool {
         self.load(u);
         if !self.model.tangent_matrix(&self.y, 1.0, &mut self.tangent) {
@@ -160,8 +164,10 @@ impl StaticProblem for Problem {
         let model = &self.model;
         let step = |i: usize| self.unknown[i].map_or(0.0, |k| delta[k]);
         let mut limit = 1.0f64;
+        // A node already on its pulley or across it (room ≤ 0: a guess that put it there) has
+        // no side to keep; the side rule sorts it out at the solution.
         let mut keep = |room: f64, toward: f64| {
-            if toward > (1.0 - KINK_KEEP) * room {
+            if room > 0.0 && toward > (1.0 - KINK_KEEP) * room {
                 limit = limit.min((1.0 - KINK_KEEP) * room / toward);
             }
         };
@@ -273,12 +279,15 @@ fn reclassify(model: &mut Lumped, y: &mut [f64], stored: [usize; 2], effector_x:
     model.set_stored(stored);
 }
 
-/// The split with a stalled boundary node moved across the pulley, if one stalled there. When a
-/// split's solution would put its last stored node (first free node) on the other side, the
-/// straddling spring's length |P_(r−1) − A| + |A − P_r| folds back at A, where it has no
-/// derivative: Newton stalls on the kink instead of converging (e.g. x = 0.1745 m, ΣT = 197 N:
-/// node 33 of cable 0 stuck 1e-10 m beyond the pulley with 0.075 N unbalanced). That node has
-/// crossed; the side rule moves it.
+/// The split with a stalled boundary node moved across the pulley, if one stalled there (within
+/// [`PULLEY_GAP`], on either side). When a split's solution lies across the pulley for its last
+/// stored node (first free node), the straddling spring's length |P_(r−1) − A| + |A − P_r|
+/// folds back at A, where it has no derivative, and [`StaticProblem::step_limit`] keeps the
+/// node on its side: Newton creeps up to the kink and fails there (before the step limit it
+/// stalled on it: x = 0.1745 m, ΣT = 197 N, node 33 of cable 0 1e-10 m beyond the pulley,
+/// 0.075 N unbalanced). That node belongs to the other side. Run on failures only; a node of
+/// the other cable that merely sits close gets shifted too, and the side rule at the next
+/// solution shifts it back (each shift spends one of [`MAX_SPLITS`]).
 fn split_across_kink(model: &Lumped, y: &[f64]) -> Option<[usize; 2]> {
     let radius = PULLEY_GAP * model.segment;
     let mut stored = model.stored();
@@ -329,7 +338,9 @@ pub(crate) fn equilibrium(
             },
         };
         // Side rule at the solution: shift the split where the last stored node is not beyond
-        // the pulley or the first free node is.
+        // the pulley or the first free node is. The step limit keeps both boundary nodes on
+        // their side from a start on their side, so this catches starts that were not (the
+        // chord guess, a re-split).
         let mut consistent = true;
         for (cable, r) in stored.iter_mut().enumerate() {
             if *r > 0 && beyond(model, &y, cable, *r - 1) <= 0.0 {
@@ -386,6 +397,7 @@ mod tests {
         let pattern = problem.pattern().unwrap();
         let mut values = vec![0.0; pattern.len()];
         assert!(problem.jacobian(&u, &mut values));
+        assert!(values.iter().all(|v| v.is_finite()));
         let mut exact = vec![0.0; n * n];
         for (&(r, c), v) in pattern.iter().zip(&values) {
             exact[r * n + c] += v;
@@ -402,6 +414,7 @@ mod tests {
             problem.residual(&moved, &mut minus);
             for r in 0..n {
                 let differenced = (plus[r] - minus[r]) / (2.0 * h);
+                assert!(differenced.is_finite(), "({r}, {c})");
                 worst = worst.max((differenced - exact[r * n + c]).abs());
                 largest = largest.max(differenced.abs());
             }

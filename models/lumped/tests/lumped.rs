@@ -62,8 +62,8 @@ fn equilibrium_matches_the_independent_solution() {
     assert!((eq.force - 0.097531).abs() < 5e-7, "F0 = {}", eq.force);
 }
 
-/// The largest force on any coordinate at `eq` under its commanded tensions [N] (node masses
-/// folded back in).
+/// The largest force on any coordinate at `eq` under its commanded tensions [N] (the masses
+/// folded back into the accelerations).
 fn largest_force(m: &mut Lumped, eq: &Equilibrium, tension_sum: f64) -> f64 {
     let mut rate = vec![0.0; m.state_len()];
     m.rhs(0.0, &eq.state, tensions(tension_sum, eq.force), &mut rate);
@@ -71,7 +71,7 @@ fn largest_force(m: &mut Lumped, eq: &Equilibrium, tension_sum: f64) -> f64 {
     (0..np)
         .map(|i| {
             let mass = if i >= 4 * m.elements {
-                1.0
+                m.effector_mass
             } else {
                 m.node_mass
             };
@@ -87,8 +87,9 @@ fn largest_force(m: &mut Lumped, eq: &Equilibrium, tension_sum: f64) -> f64 {
 ///   and the error was returned instead of moving the node across;
 /// - (0.1735, 121.4), (0.4255, 163.4), (0.6005, 197), (0.7015, 132.6): the node moved across
 ///   started 2.5e-5 m from the pulley, which slackened its neighbours' springs (238 N residual);
-/// - (0.324825, 231.44), (0.675175, 231.44): the solution's node is 2.85e-8 m from the pulley,
-///   inside the finite-difference step, and an unlimited step landed on the kink (5.6e-21 m).
+/// - (0.324825, 231.44), (0.675175, 231.44): the solution's node is 2.85e-8 m from the pulley;
+///   iterates near it had the 6e-10 m difference step straddle the kink, and an unlimited step
+///   landed on it (5.6e-21 m).
 ///
 /// Same criteria as the proptest below.
 #[test]
