@@ -3,7 +3,8 @@
 //! - `simulate`: one scenario → `timeseries.csv` and `metrics.json`;
 //! - `report`: the paper scenario for every available model → `REPORT.md` and `metrics.json`;
 //! - `work-precision`: error vs cost of DOPRI5 and generalised-α on the massive-cable models;
-//! - `modes`: closed- and open-loop modes of every model and the axial-damping sweep.
+//! - `modes`: closed- and open-loop modes of every model and the axial-damping sweep;
+//! - `statics-sweep`: the static equilibrium over a grid of starts, counting failures.
 //!
 //! Errors are printed for a person and give a non-zero exit; a failed run keeps its output.
 
@@ -12,6 +13,7 @@ mod modes;
 mod output;
 mod report;
 mod simulate;
+mod statics_sweep;
 mod work_precision;
 
 use clap::{Parser, Subcommand};
@@ -74,6 +76,31 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// The static equilibrium (MODELS.md §2) at every start of an x × ΣT grid (cell midpoints);
+    /// prints the starts that fail and exits non-zero if any does. The defaults are the lumped
+    /// property test's ranges at 2000 × 250 points (~2 min for lumped or FE).
+    StaticsSweep {
+        /// Scenario file (TOML, MODELS.md §9); absent = the paper's scenario.
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// Cable model, overriding the scenario's [model] kind: elastic | lumped | fe.
+        #[arg(long)]
+        model: Option<String>,
+        /// Effector x range [m] and its number of points.
+        #[arg(long, default_value_t = 0.15)]
+        x_min: f64,
+        #[arg(long, default_value_t = 0.85)]
+        x_max: f64,
+        #[arg(long, default_value_t = 2000)]
+        x_steps: usize,
+        /// Tension sum ΣT range [N] and its number of points.
+        #[arg(long, default_value_t = 120.0)]
+        tension_min: f64,
+        #[arg(long, default_value_t = 400.0)]
+        tension_max: f64,
+        #[arg(long, default_value_t = 250)]
+        tension_steps: usize,
+    },
 }
 
 fn main() -> ExitCode {
@@ -88,6 +115,29 @@ fn main() -> ExitCode {
         Command::Report { out, scenario } => report::run(scenario.as_deref(), &out),
         Command::WorkPrecision { out } => work_precision::run_study(&out),
         Command::Modes { scenario, at, out } => modes::run(scenario.as_deref(), at, &out),
+        Command::StaticsSweep {
+            scenario,
+            model,
+            x_min,
+            x_max,
+            x_steps,
+            tension_min,
+            tension_max,
+            tension_steps,
+        } => statics_sweep::run(
+            scenario.as_deref(),
+            model.as_deref(),
+            statics_sweep::Axis {
+                min: x_min,
+                max: x_max,
+                steps: x_steps,
+            },
+            statics_sweep::Axis {
+                min: tension_min,
+                max: tension_max,
+                steps: tension_steps,
+            },
+        ),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

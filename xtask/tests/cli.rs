@@ -175,3 +175,47 @@ fn modes_outside_the_workspace_is_an_error() {
         "{stderr}"
     );
 }
+
+/// The 100 × 20 grid over the lumped property test's ranges on which the first two failures of
+/// the statics beside a pulley were found (x = 0.1745 and 0.8255 m at ΣT = 197 N): every start
+/// now finds its equilibrium, and the summary says so.
+#[test]
+fn statics_sweep_finds_every_lumped_equilibrium() {
+    let output = xtask()
+        .args([
+            "statics-sweep",
+            "--model",
+            "lumped",
+            "--x-steps",
+            "100",
+            "--tension-steps",
+            "20",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(
+        stdout.contains("lumped: 0 of 2000 starts found no equilibrium"),
+        "{stdout}"
+    );
+}
+
+/// A sweep range outside the workspace names the option and the allowed interval.
+#[test]
+fn statics_sweep_outside_the_workspace_is_an_error() {
+    let output = xtask()
+        .args(["statics-sweep", "--x-max", "1.2"])
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("--x-max") && stderr.contains("(0, 1)"),
+        "{stderr}"
+    );
+}

@@ -82,7 +82,7 @@ fn largest_force(m: &mut Lumped, eq: &Equilibrium, tension_sum: f64) -> f64 {
 
 /// Starts whose equilibrium puts a node within microns of a pulley, where eq. 4's straddling
 /// length |P − A| has its kink: found by sweeping the proptest's ranges (700 × 100 and
-/// 2000 × 250 grids) after CI hit the first. What each one broke:
+/// 2000 × 250 grids, `cargo xtask statics-sweep`) after CI hit the first. What each one broke:
 /// - (0.1745, 197), (0.8255, 197): Newton stalled 1e-10 m beyond the pulley, 0.075 N unbalanced,
 ///   and the error was returned instead of moving the node across;
 /// - (0.1735, 121.4), (0.4255, 163.4), (0.6005, 197), (0.7015, 132.6): the node moved across
