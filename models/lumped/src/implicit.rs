@@ -63,15 +63,8 @@ impl Lumped {
         }
     }
 
-    /// S = diag(m) − c_q ∂F/∂q for undamped springs, analytically, into `values` (pattern
-    /// order). A taut chord spring (u = (b − a)/λ, T = k (λ − l0)) pulls a with T u, whose
-    /// derivative in b is K = k u uᵀ + (T/λ)(I − u uᵀ) (in a: −K; b's force the opposite). The
-    /// straddling spring (λ = |P − a| + |P − b|, eq. 4) pulls each end towards the pulley,
-    /// F_a = T u_a: ∂F_a/∂a = −k u_a u_aᵀ − (T/|P − a|)(I − u_a u_aᵀ), ∂F_a/∂b = −k u_a u_bᵀ. A
-    /// slack spring adds nothing; a stored node's z row is its mass alone (MODELS.md §4: the
-    /// constraint holds it on z = 0). False (values unusable) where a straddling end sits exactly
-    /// at its pulley (no direction there).
-    pub(crate) fn tangent_matrix(&self, state: &[f64], c_q: f64, values: &mut [f64]) -> bool {
+    /// diag(m) in the order of [`SecondOrderForm::iteration_pattern`] (every other entry 0).
+    pub(crate) fn mass_matrix_into(&self, values: &mut [f64]) {
         let n = self.elements;
         values.fill(0.0);
         for cable in 0..2 {
@@ -84,6 +77,19 @@ impl Lumped {
         for r in 0..2 {
             values[self.pattern_index(0, n, n, r, r)] = self.effector_mass;
         }
+    }
+
+    /// S = diag(m) − c_q ∂F/∂q for undamped springs, analytically, into `values` (pattern
+    /// order). A taut chord spring (u = (b − a)/λ, T = k (λ − l0)) pulls a with T u, whose
+    /// derivative in b is K = k u uᵀ + (T/λ)(I − u uᵀ) (in a: −K; b's force the opposite). The
+    /// straddling spring (λ = |P − a| + |P − b|, eq. 4) pulls each end towards the pulley,
+    /// F_a = T u_a: ∂F_a/∂a = −k u_a u_aᵀ − (T/|P − a|)(I − u_a u_aᵀ), ∂F_a/∂b = −k u_a u_bᵀ. A
+    /// slack spring adds nothing; a stored node's z row is its mass alone (MODELS.md §4: the
+    /// constraint holds it on z = 0). False (values unusable) where a straddling end sits exactly
+    /// at its pulley (no direction there).
+    pub(crate) fn tangent_matrix(&self, state: &[f64], c_q: f64, values: &mut [f64]) -> bool {
+        let n = self.elements;
+        self.mass_matrix_into(values);
         let (k, l0) = (self.stiffness, self.segment);
         let outer = |u: Vector2<f64>, w: Vector2<f64>| u * w.transpose();
         let identity = nalgebra::Matrix2::identity();

@@ -32,8 +32,12 @@ struct Problem {
     map: Vec<usize>,
     /// Inverse of `map`: the unknown of each position coordinate, if it is one.
     unknown: Vec<Option<usize>>,
-    /// The model's iteration pattern (over the positions q) and two value buffers for it.
+    /// The model's iteration pattern (over the positions q), and the indices into it of the
+    /// entries [`StaticProblem::pattern`] keeps, in its order.
     dynamic: Vec<(usize, usize)>,
+    kept: Vec<usize>,
+    /// [`Lumped::tangent_matrix`]'s values at c_q = 1, and diag(m) in the same order (which no
+    /// state changes).
     tangent: Vec<f64>,
     masses: Vec<f64>,
 }
@@ -55,18 +59,29 @@ impl Problem {
             unknown[i] = Some(k);
         }
         let dynamic = model.iteration_pattern();
-        Self {
+        let mut masses = vec![0.0; dynamic.len()];
+        model.mass_matrix_into(&mut masses);
+        let mut problem = Self {
             y: vec![0.0; model.state_len()],
             forces: vec![0.0; model.positions_len()],
             tangent: vec![0.0; dynamic.len()],
-            masses: vec![0.0; dynamic.len()],
+            masses,
+            kept: Vec::new(),
             dynamic,
             unknown,
             model,
             effector_x,
             tension_sum,
             map,
-        }
+        };
+        // The filter of `statics::pattern_from_dynamics` as `pattern` calls it.
+        problem.kept = (0..problem.dynamic.len())
+            .filter(|&p| {
+                let (row, col) = problem.dynamic[p];
+                problem.row_of(row).is_some() && problem.unknown[col].is_some()
+            })
+            .collect();
+        problem
     }
 
     /// The equation of position row `i`: its force balance, or F0's for the effector's x.
@@ -122,7 +137,7 @@ impl StaticProblem for Problem {
         ))
     }
     /// Exact, from the springs' tangent stiffness ([`Lumped::tangent_matrix`] gives
-    /// S = diag(m) − c_q ∂F/∂q, so S(0) − S(1) = ∂F/∂q; the residual here is F), in the order
+    /// S = diag(m) − c_q ∂F/∂q, so diag(m) − S(1) = ∂F/∂q; the residual here is F), in the order
     /// [`statics::pattern_from_dynamics`] gives [`Self::pattern`], then F0's column:
     /// T_i = (ΣT ∓ F0)/2 pulls P_0 along e_out (MODELS.md §4). Why not differences: an iterate
     /// whose boundary node comes within their step (6e-10 m) of its pulley has them straddle
@@ -137,14 +152,10 @@ impl StaticProblem for Problem {
         if !self.model.tangent_matrix(&self.y, 1.0, &mut self.tangent) {
             return false;
         }
-        self.model.tangent_matrix(&self.y, 0.0, &mut self.masses);
-        let mut at = 0;
-        for (p, &(row, col)) in self.dynamic.iter().enumerate() {
-            if self.row_of(row).is_some() && self.unknown[col].is_some() {
-                values[at] = self.masses[p] - self.tangent[p];
-                at += 1;
-            }
+        for (value, &p) in values.iter_mut().zip(&self.kept) {
+            *value = self.masses[p] - self.tangent[p];
         }
+        let mut at = self.kept.len();
         for (cable, row) in self.model.tension_rows().into_iter().enumerate() {
             if self.row_of(row).is_some() {
                 values[at] = [-0.5, 0.5][cable] * E_OUT[cable];
@@ -279,6 +290,27 @@ fn reclassify(model: &mut Lumped, y: &mut [f64], stored: [usize; 2], effector_x:
     model.set_stored(stored);
 }
 
+/// The split with each cable's boundary moved by one node where `crossed(cable, j, stored)` says
+/// its last stored node (`stored`) or else its first free node j belongs on the other side;
+/// None if no boundary moves. The one rule behind both checks of [`equilibrium`].
+fn shifted_split(
+    model: &Lumped,
+    crossed: impl Fn(usize, usize, bool) -> bool,
+) -> Option<[usize; 2]> {
+    let mut stored = model.stored();
+    let mut shifted = false;
+    for (cable, r) in stored.iter_mut().enumerate() {
+        if *r > 0 && crossed(cable, *r - 1, true) {
+            *r -= 1;
+            shifted = true;
+        } else if *r < model.elements && crossed(cable, *r, false) {
+            *r += 1;
+            shifted = true;
+        }
+    }
+    shifted.then_some(stored)
+}
+
 /// The split with a stalled boundary node moved across the pulley, if one stalled there (within
 /// [`PULLEY_GAP`], on either side). When a split's solution lies across the pulley for its last
 /// stored node (first free node), the straddling spring's length |P_(r−1) − A| + |A − P_r|
@@ -290,19 +322,17 @@ fn reclassify(model: &mut Lumped, y: &mut [f64], stored: [usize; 2], effector_x:
 /// solution shifts it back (each shift spends one of [`MAX_SPLITS`]).
 fn split_across_kink(model: &Lumped, y: &[f64]) -> Option<[usize; 2]> {
     let radius = PULLEY_GAP * model.segment;
-    let mut stored = model.stored();
-    let mut shifted = false;
-    for (cable, r) in stored.iter_mut().enumerate() {
-        let at_kink = |j: usize| (model.node(y, cable, j) - model.pulley(cable)).norm() < radius;
-        if *r > 0 && at_kink(*r - 1) {
-            *r -= 1;
-            shifted = true;
-        } else if *r < model.elements && at_kink(*r) {
-            *r += 1;
-            shifted = true;
-        }
-    }
-    shifted.then_some(stored)
+    shifted_split(model, |cable, j, _| {
+        (model.node(y, cable, j) - model.pulley(cable)).norm() < radius
+    })
+}
+
+/// The split the side rule asks for at a solution (MODELS.md §4): the last stored node must lie
+/// beyond the pulley, the first free node not; None if both do.
+fn split_by_side_rule(model: &Lumped, y: &[f64]) -> Option<[usize; 2]> {
+    shifted_split(model, |cable, j, stored| {
+        (beyond(model, y, cable, j) > 0.0) != stored
+    })
 }
 
 /// Equilibrium with the split found by the side rule (MODELS.md §2, §4).
@@ -318,7 +348,6 @@ pub(crate) fn equilibrium(
     let sag = -weight * effector_x * (d - effector_x) / (0.5 * tension_sum * d);
     let ea = model.stiffness * model.segment;
     let mut y = guess(model, Vector2::new(effector_x, sag), 0.5 * tension_sum, ea);
-    let n = model.elements;
     for _attempt in 0..MAX_SPLITS {
         let mut problem = Problem::new(model.clone(), effector_x, tension_sum);
         let mut u: Vec<f64> = problem.map.iter().map(|&i| y[i]).collect();
@@ -326,7 +355,6 @@ pub(crate) fn equilibrium(
         let solved = statics::solve(&mut problem, &mut u, NewtonOptions::default());
         problem.load(&u);
         y.copy_from_slice(&problem.y);
-        let mut stored = model.stored();
         let report = match solved {
             Ok(report) => report,
             Err(error) => match split_across_kink(model, &y) {
@@ -341,25 +369,17 @@ pub(crate) fn equilibrium(
         // the pulley or the first free node is. The step limit keeps both boundary nodes on
         // their side from a start on their side, so this catches starts that were not (the
         // chord guess, a re-split).
-        let mut consistent = true;
-        for (cable, r) in stored.iter_mut().enumerate() {
-            if *r > 0 && beyond(model, &y, cable, *r - 1) <= 0.0 {
-                *r -= 1;
-                consistent = false;
-            } else if *r < n && beyond(model, &y, cable, *r) > 0.0 {
-                *r += 1;
-                consistent = false;
+        match split_by_side_rule(model, &y) {
+            Some(shifted) => reclassify(model, &mut y, shifted, effector_x),
+            None => {
+                return Ok(Equilibrium {
+                    state: y,
+                    force: u[problem.map.len()],
+                    iterations: report.iterations,
+                    residual: report.residual,
+                });
             }
         }
-        if consistent {
-            return Ok(Equilibrium {
-                state: y,
-                force: u[problem.map.len()],
-                iterations: report.iterations,
-                residual: report.residual,
-            });
-        }
-        reclassify(model, &mut y, stored, effector_x);
     }
     Err(ModelError::State {
         t: 0.0,
