@@ -128,6 +128,23 @@ pub struct ElementTerms {
     pub fl: f64,
 }
 
+impl ElementTerms {
+    /// The element's rows of R = M q'' − F (FE.9.3) at node accelerations a_a, a_b [m/s²] and
+    /// l'' [m/s²]: (rows r_a, rows r_b, row l) [N].
+    #[inline(always)]
+    pub fn residual(
+        &self,
+        aa: Vector2<f64>,
+        ab: Vector2<f64>,
+        al: f64,
+    ) -> (Vector2<f64>, Vector2<f64>, f64) {
+        let ra = aa * self.m_diag + ab * self.m_off + self.m_al * al - self.fa;
+        let rb = aa * self.m_off + ab * self.m_diag + self.m_bl * al - self.fb;
+        let rl = self.m_al.dot(&aa) + self.m_bl.dot(&ab) + self.m_ll * al - self.fl;
+        (ra, rb, rl)
+    }
+}
+
 /// M_e and F_e of MODELS.md FE.5.3 for one element (no axial damping).
 #[inline]
 pub fn terms(mat: &Material, k: &MassCoefficients, s: &ElementState) -> ElementTerms {

@@ -26,7 +26,7 @@ mod statics;
 
 use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError};
 use cdpr_core::scenario::{FeMass, FeStored, Scenario};
-use element::{Chord, ElementState, MassCoefficients, Material};
+use element::{Chord, ElementState, ElementTerms, MassCoefficients, Material};
 use nalgebra::Vector2;
 use solve::ChainSystem;
 
@@ -293,12 +293,9 @@ impl Fe {
         }
     }
 
-    /// Assembles M(q) and F(q, q', T) (FE.5.3) into the block system of FE.5.5.
-    fn assemble(&mut self, y: &[f64], tensions: [f64; 2]) {
-        let mut sys = std::mem::take(&mut self.system);
-        sys.clear();
-        let n = self.elements;
-        let mat = self.material;
+    /// The chain's chords from positions `y` into the pass [`Self::for_each_span_element`] reads.
+    #[inline]
+    fn update_chords(&mut self, y: &[f64]) {
         let nn = self.chain_nodes();
         element::chords(
             &y[..nn],
@@ -306,19 +303,44 @@ impl Fe {
             &mut self.chord_length,
             &mut self.chord_inv_length,
         );
+    }
+
+    /// Calls `add(j_a, j_b, M_e and F_e)` for the free elements e = 1 (at the pulley) … N of
+    /// `cable`'s span (FE.5.3), with their chain nodes (j_a: None for the pulley node): the one
+    /// loop both the explicit assembly and the implicit residual run. The chords must be `y`'s
+    /// ([`Self::update_chords`]). Internal iteration, inlined into each caller, so the element
+    /// terms stay in registers.
+    #[inline(always)]
+    fn for_each_span_element(
+        &self,
+        y: &[f64],
+        cable: usize,
+        mut add: impl FnMut(Option<usize>, usize, &ElementTerms),
+    ) {
+        for (e, (s, k)) in (1..=self.elements).zip(self.span(y, cable).zip(&self.coefficients)) {
+            let ja = self.chain_index(cable, e - 1);
+            let jb = self.chain_index(cable, e).expect("node e ≥ 1 is free");
+            // An element between chain nodes j, j + 1 has chord j of the pass; element 1 starts
+            // at the pulley, which is not a chain node.
+            let chord = match ja {
+                Some(ja) => self.chord_at(ja.min(jb)),
+                None => Chord::of(&s),
+            };
+            let t = element::terms_at_chord(&self.material, k, &s, self.axial_damping, chord);
+            add(ja, jb, &t);
+        }
+    }
+
+    /// Assembles M(q) and F(q, q', T) (FE.5.3) into the block system of FE.5.5.
+    fn assemble(&mut self, y: &[f64], tensions: [f64; 2]) {
+        let mut sys = std::mem::take(&mut self.system);
+        sys.clear();
+        let mat = self.material;
+        self.update_chords(y);
         for cable in 0..2 {
             let lb = sys.l_index[cable];
             let col = 2 + 2 * cable;
-            for (e, (s, k)) in (1..=n).zip(self.span(y, cable).zip(&self.coefficients)) {
-                let ja = self.chain_index(cable, e - 1);
-                let jb = self.chain_index(cable, e).expect("node e ≥ 1 is free");
-                // An element between chain nodes j, j + 1 has chord j of the pass; element 1
-                // starts at the pulley, which is not a chain node.
-                let chord = match ja {
-                    Some(ja) => self.chord_at(ja.min(jb)),
-                    None => Chord::of(&s),
-                };
-                let t = element::terms_at_chord(&mat, k, &s, self.axial_damping, chord);
+            self.for_each_span_element(y, cable, |ja, jb, t| {
                 if let Some(ja) = ja {
                     sys.diag[ja] += t.m_diag;
                     sys.off[ja.min(jb)] += t.m_off;
@@ -336,7 +358,7 @@ impl Fe {
                 r[col + 1] += t.m_bl.y;
                 sys.d[lb][lb] += t.m_ll;
                 sys.f_border[lb] += t.fl;
-            }
+            });
             let li = self.l_index(cable);
             match self.stored_element(y, cable) {
                 Some(s) => {
