@@ -6,7 +6,7 @@
 
 use cdpr_core::integrate::AlphaCoefficients;
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{IntegratorKind, ModelKind, Scenario};
+use cdpr_core::scenario::{FeStored, IntegratorKind, ModelKind, Scenario};
 use cdpr_verify::{acceptance, assess, model, simulate};
 use proptest::prelude::*;
 
@@ -32,6 +32,7 @@ fn paper(kind: ModelKind, integrator: IntegratorKind) -> Scenario {
 /// must lie in the declared pattern.
 fn check_iteration_matrix(
     kind: ModelKind,
+    fe_stored: FeStored,
     damping: f64,
     x: f64,
     velocity: f64,
@@ -40,6 +41,7 @@ fn check_iteration_matrix(
 ) {
     let mut scenario = paper(kind, IntegratorKind::Implicit);
     scenario.cable.axial_damping = damping;
+    scenario.model.fe_stored = fe_stored;
     let mut m = model(&scenario).unwrap();
     let eq = m.equilibrium(x, scenario.controller.tension_sum).unwrap();
     let form = m.second_order_mut().unwrap();
@@ -92,12 +94,12 @@ fn check_iteration_matrix(
             let (ours, fd) = (model_s[row * n + col], fd_s[row * n + col]);
             assert!(
                 (ours - fd).abs() <= 1e-6 * scale,
-                "{kind}: S[{row}][{col}] = {ours:e}, differences {fd:e} (scale {scale:e})"
+                "{kind} ({fe_stored:?}): S[{row}][{col}] = {ours:e}, differences {fd:e} (scale {scale:e})"
             );
             if fd.abs() > 1e-6 * scale {
                 assert!(
                     declared[row * n + col],
-                    "{kind}: ({row}, {col}) missing from the pattern"
+                    "{kind} ({fe_stored:?}): ({row}, {col}) missing from the pattern"
                 );
             }
         }
@@ -120,8 +122,13 @@ proptest! {
         damping in prop::option::of(0.5f64..5.0),
     ) {
         let (c_v, c_q) = AlphaCoefficients::new(rho_inf).derivatives(h);
-        for kind in [ModelKind::Lumped, ModelKind::Fe] {
-            check_iteration_matrix(kind, damping.unwrap_or(0.0), x, velocity, c_v, c_q);
+        // FE with both stored variants (the rigid stored cable has blocks of its own).
+        for (kind, stored) in [
+            (ModelKind::Lumped, FeStored::Elastic),
+            (ModelKind::Fe, FeStored::Elastic),
+            (ModelKind::Fe, FeStored::Rigid),
+        ] {
+            check_iteration_matrix(kind, stored, damping.unwrap_or(0.0), x, velocity, c_v, c_q);
         }
     }
 }

@@ -1,5 +1,6 @@
 //! The FE model's second-order form for the implicit integrator (MODELS.md FE.9.3):
-//! R = M(q) q'' − F(q, q', T) from the same assembly as the explicit right-hand side, and the
+//! R = M(q) q'' − F(q, q', T) summed element by element on the span loop the explicit assembly
+//! runs ([`Fe::for_each_span_element`](crate::Fe)), and the
 //! iteration matrix S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q element by element.
 //!
 //! Why element by element: the rows l_i are dense (every node of a span feeds its length's
@@ -339,7 +340,7 @@ impl SecondOrderForm for Fe {
                     r[rho] += rows[0] - tension;
                     r[li] += rows[1];
                 }
-                _ => {
+                (None, None) => {
                     let rows = self.block_residual(
                         Block::Rigid { cable },
                         &[state[li], 0.0, 0.0, 0.0, 0.0],
@@ -348,6 +349,7 @@ impl SecondOrderForm for Fe {
                     );
                     r[li] += rows[0] + tension;
                 }
+                _ => unreachable!("ρ_i and the stored element exist together"),
             }
         }
         let p = self.effector_index();

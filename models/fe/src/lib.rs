@@ -16,7 +16,8 @@
 //! The rigid-stored variant (FE.1.3) drops ρ_i: the border is (l1, l2), n = 4(N − 1) + 4.
 //!
 //! Per right-hand side: assemble M(q) and F(q, q', T) element by element ([`element::terms`]), then
-//! the O(N) block solve of FE.5.5 ([`solve::ChainSystem`]); nothing is allocated.
+//! the O(N) block solve of FE.5.5 ([`solve::ChainSystem`]); nothing is allocated. The implicit
+//! path's residual M q'' − F sums the same element terms without assembling (`implicit`).
 
 pub mod chain;
 pub mod element;
@@ -93,7 +94,8 @@ pub struct Fe {
     border: usize,
     /// Assembled M, F and the solve's scratch (allocated once; taken out while assembling).
     system: ChainSystem,
-    /// The chain's chords (between consecutive chain nodes) and their inverses, per assembly.
+    /// The chain's chords (between consecutive chain nodes) and their inverses, per assembly or
+    /// implicit residual.
     chord_length: Vec<f64>,
     chord_inv_length: Vec<f64>,
 }
@@ -284,7 +286,8 @@ impl Fe {
         ))
     }
 
-    /// Chord j of the chain from the last assembly's pass.
+    /// Chord j of the chain from the last [`Self::update_chords`] (an assembly's or an implicit
+    /// residual's).
     #[inline]
     fn chord_at(&self, j: usize) -> Chord {
         Chord {
