@@ -60,6 +60,18 @@ pub trait StaticProblem {
     }
 }
 
+/// A static problem's Jacobian pattern, from [`pattern_from_dynamics`].
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct StaticPattern {
+    /// (equation, unknown): the dynamic pattern's entries whose row and column both map, in its
+    /// order, then the column of the PID force F0.
+    pub entries: Vec<(usize, usize)>,
+    /// The index in the dynamic pattern of each mapped entry (the first `kept.len()` of
+    /// `entries`): a problem whose Jacobian comes from the model's matrix values (in the dynamic
+    /// order) takes them through these, without repeating the mapping.
+    pub kept: Vec<usize>,
+}
+
 /// A static problem's Jacobian pattern from its model's second-order pattern (`dynamic`, over q):
 /// rows and columns of q mapped to the problem's equations and unknowns (None: not one), and the
 /// column of the PID force F0 (unknown `force`) in the rows of q where the commanded tensions act.
@@ -69,17 +81,18 @@ pub fn pattern_from_dynamics(
     col_of: impl Fn(usize) -> Option<usize>,
     tension_rows: &[usize],
     force: usize,
-) -> Vec<(usize, usize)> {
-    let mut pattern: Vec<(usize, usize)> = dynamic
+) -> StaticPattern {
+    let (kept, mut entries): (Vec<usize>, Vec<(usize, usize)>) = dynamic
         .iter()
-        .filter_map(|&(r, c)| Some((row_of(r)?, col_of(c)?)))
-        .collect();
-    pattern.extend(
+        .enumerate()
+        .filter_map(|(p, &(r, c))| Some((p, (row_of(r)?, col_of(c)?))))
+        .unzip();
+    entries.extend(
         tension_rows
             .iter()
             .filter_map(|&r| Some((row_of(r)?, force))),
     );
-    pattern
+    StaticPattern { entries, kept }
 }
 
 /// The Newton direction's linear algebra: a dense LU of the full finite-difference Jacobian, or

@@ -20,8 +20,9 @@ struct Problem<'a> {
     y: Vec<f64>,
     /// Indices in q of the length unknowns, in order (F0 is the last unknown).
     map: Vec<usize>,
-    /// The model's second-order pattern over q and, per entry, its ∂R/∂q (Jacobian scratch).
-    dynamic: Vec<(usize, usize)>,
+    /// The Jacobian's pattern, from the model's second-order pattern over q, and per entry of
+    /// that, its ∂R/∂q (Jacobian scratch).
+    pattern: statics::StaticPattern,
     stiffness: Vec<f64>,
     /// Scratch of the Jacobian: q'' = 0 (at rest), the unknowns with F0 moved, and the residuals
     /// for F0's column.
@@ -71,35 +72,23 @@ impl StaticProblem for Problem<'_> {
     /// The assembly's pattern (`SecondOrderForm::iteration_pattern`: node blocks and the l
     /// border) over the unknowns (every q but the effector's x, whose row is F0's equation).
     fn pattern(&self) -> Option<Vec<(usize, usize)>> {
-        let p = self.model.effector_index();
-        let force = self.map.len();
-        Some(statics::pattern_from_dynamics(
-            &self.dynamic,
-            Some,
-            |j| (j != p).then(|| j - usize::from(j > p)),
-            &self.model.tension_rows(),
-            force,
-        ))
+        Some(self.pattern.entries.clone())
     }
     fn residual_round_off(&self) -> f64 {
         self.model.residual_round_off(&self.y)
     }
     /// Element by element ([`Fe::block_matrix`] with weights [1, 0, 0] at rest: ∂R/∂q of
-    /// R = M q'' − F, and the residual here is F, so the entries change sign), in the order
-    /// [`statics::pattern_from_dynamics`] gives [`Self::pattern`]: the model's entries without
-    /// the effector's x column, then F0's column, exact by one unit difference (F is affine in
+    /// R = M q'' − F, and the residual here is F, so the entries change sign), in the order of
+    /// [`Self::pattern`]: the model's entries it keeps ([`statics::StaticPattern::kept`]: all
+    /// but the effector's x column), then F0's column, exact by one unit difference (F is affine in
     /// F0 through T_i = (ΣT ∓ F0)/2).
     fn jacobian(&mut self, u: &[f64], values: &mut [f64]) -> bool {
         self.load(u);
         self.model
             .block_matrix(&self.y, &self.at_rest, [1.0, 0.0, 0.0], &mut self.stiffness);
-        let p = self.model.effector_index();
-        let mut at = 0;
-        for (&(_, col), &k) in self.dynamic.iter().zip(&self.stiffness) {
-            if col != p {
-                values[at] = -k;
-                at += 1;
-            }
+        let (stiffness, force_column) = values.split_at_mut(self.pattern.kept.len());
+        for (value, &p) in stiffness.iter_mut().zip(&self.pattern.kept) {
+            *value = -self.stiffness[p];
         }
         let force = self.map.len();
         let (mut base, mut pulled, mut moved) = (
@@ -112,9 +101,10 @@ impl StaticProblem for Problem<'_> {
         moved[force] += 1.0;
         self.residual(&moved, &mut pulled);
         self.load(u);
-        for row in self.model.tension_rows() {
-            values[at] = pulled[row] - base[row];
-            at += 1;
+        let rows = self.model.tension_rows();
+        debug_assert_eq!(force_column.len(), rows.len());
+        for (value, row) in force_column.iter_mut().zip(rows) {
+            *value = pulled[row] - base[row];
         }
         (self.base, self.pulled, self.moved) = (base, pulled, moved);
         true
@@ -197,6 +187,13 @@ fn problem(
     u.push(0.0);
     let dynamic = model.iteration_pattern();
     let unknowns = map.len() + 1;
+    let pattern = statics::pattern_from_dynamics(
+        &dynamic,
+        Some,
+        |j| (j != p).then(|| j - usize::from(j > p)),
+        &model.tension_rows(),
+        map.len(),
+    );
     let problem = Problem {
         model,
         effector_x,
@@ -204,7 +201,7 @@ fn problem(
         y,
         map,
         stiffness: vec![0.0; dynamic.len()],
-        dynamic,
+        pattern,
         at_rest: vec![0.0; np],
         moved: vec![0.0; unknowns],
         base: vec![0.0; unknowns],

@@ -32,10 +32,8 @@ struct Problem {
     map: Vec<usize>,
     /// Inverse of `map`: the unknown of each position coordinate, if it is one.
     unknown: Vec<Option<usize>>,
-    /// The model's iteration pattern (over the positions q), and the indices into it of the
-    /// entries [`StaticProblem::pattern`] keeps, in its order.
-    dynamic: Vec<(usize, usize)>,
-    kept: Vec<usize>,
+    /// The Jacobian's pattern, from the model's iteration pattern (over the positions q).
+    pattern: statics::StaticPattern,
     /// [`Lumped::tangent_matrix`]'s values at c_q = 1, and diag(m) in the same order (which no
     /// state changes).
     tangent: Vec<f64>,
@@ -66,21 +64,20 @@ impl Problem {
             forces: vec![0.0; model.positions_len()],
             tangent: vec![0.0; dynamic.len()],
             masses,
-            kept: Vec::new(),
-            dynamic,
+            pattern: statics::StaticPattern::default(),
             unknown,
             model,
             effector_x,
             tension_sum,
             map,
         };
-        // The filter of `statics::pattern_from_dynamics` as `pattern` calls it.
-        problem.kept = (0..problem.dynamic.len())
-            .filter(|&p| {
-                let (row, col) = problem.dynamic[p];
-                problem.row_of(row).is_some() && problem.unknown[col].is_some()
-            })
-            .collect();
+        problem.pattern = statics::pattern_from_dynamics(
+            &dynamic,
+            |i| problem.row_of(i),
+            |j| problem.unknown[j],
+            &problem.model.tension_rows(),
+            problem.map.len(),
+        );
         problem
     }
 
@@ -128,17 +125,11 @@ impl StaticProblem for Problem {
     /// The chain's pattern (`SecondOrderForm::iteration_pattern`) over the unknowns; the
     /// effector's x row is F0's equation.
     fn pattern(&self) -> Option<Vec<(usize, usize)>> {
-        Some(statics::pattern_from_dynamics(
-            &self.dynamic,
-            |i| self.row_of(i),
-            |j| self.unknown[j],
-            &self.model.tension_rows(),
-            self.map.len(),
-        ))
+        Some(self.pattern.entries.clone())
     }
     /// Exact, from the springs' tangent stiffness ([`Lumped::tangent_matrix`] gives
-    /// S = diag(m) − c_q ∂F/∂q, so diag(m) − S(1) = ∂F/∂q; the residual here is F), in the order
-    /// [`statics::pattern_from_dynamics`] gives [`Self::pattern`], then F0's column:
+    /// S = diag(m) − c_q ∂F/∂q, so diag(m) − S(1) = ∂F/∂q; the residual here is F), the entries
+    /// [`Self::pattern`] keeps ([`statics::StaticPattern::kept`]), then F0's column:
     /// T_i = (ΣT ∓ F0)/2 pulls P_0 along e_out (MODELS.md §4). Why not differences: an iterate
     /// whose boundary node comes within their step (6e-10 m) of its pulley has them straddle
     /// the kink of eq. 4's |P − A|, and Newton stalled there (6 of 500 000 starts over the
@@ -152,10 +143,11 @@ impl StaticProblem for Problem {
         if !self.model.tangent_matrix(&self.y, 1.0, &mut self.tangent) {
             return false;
         }
-        for (value, &p) in values.iter_mut().zip(&self.kept) {
+        let kept = &self.pattern.kept;
+        for (value, &p) in values.iter_mut().zip(kept) {
             *value = self.masses[p] - self.tangent[p];
         }
-        let mut at = self.kept.len();
+        let mut at = kept.len();
         for (cable, row) in self.model.tension_rows().into_iter().enumerate() {
             if self.row_of(row).is_some() {
                 values[at] = [-0.5, 0.5][cable] * E_OUT[cable];
