@@ -101,7 +101,7 @@ impl Problem {
         for (k, &i) in self.map.iter().enumerate() {
             self.y[i] = u[k];
         }
-        self.y[4 * self.model.elements] = self.effector_x;
+        self.y[self.model.effector_x()] = self.effector_x;
     }
 }
 
@@ -120,7 +120,7 @@ impl StaticProblem for Problem {
             r[k] = self.forces[i];
         }
         // The effector's horizontal balance closes the system for F0.
-        r[self.map.len()] = self.forces[4 * self.model.elements];
+        r[self.map.len()] = self.forces[self.model.effector_x()];
     }
     /// The chain's pattern (`SecondOrderForm::iteration_pattern`) over the unknowns; the
     /// effector's x row is F0's equation.
