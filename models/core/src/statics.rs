@@ -8,7 +8,7 @@
 //! is the tolerance.
 
 use crate::integrate::sparse::IterationMatrix;
-use crate::second_order::{CBRT_EPSILON, ColouredDifferences};
+use crate::second_order::{CBRT_EPSILON, ColouredDifferences, max_abs};
 use faer::Mat;
 use faer::prelude::Solve;
 
@@ -256,10 +256,6 @@ const MAX_HALVINGS: usize = 40;
 
 fn norm2(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
-}
-
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
 /// Solves R(u) = 0 from the guess in `unknowns` (overwritten with the solution), with a central
