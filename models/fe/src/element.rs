@@ -128,23 +128,6 @@ pub struct ElementTerms {
     pub fl: f64,
 }
 
-impl ElementTerms {
-    /// The element's rows of R = M q'' − F (FE.9.3) at node accelerations a_a, a_b [m/s²] and
-    /// l'' [m/s²]: (rows r_a, rows r_b, row l) [N].
-    #[inline(always)]
-    pub fn residual(
-        &self,
-        aa: Vector2<f64>,
-        ab: Vector2<f64>,
-        al: f64,
-    ) -> (Vector2<f64>, Vector2<f64>, f64) {
-        let ra = aa * self.m_diag + ab * self.m_off + self.m_al * al - self.fa;
-        let rb = aa * self.m_off + ab * self.m_diag + self.m_bl * al - self.fb;
-        let rl = self.m_al.dot(&aa) + self.m_bl.dot(&ab) + self.m_ll * al - self.fl;
-        (ra, rb, rl)
-    }
-}
-
 /// M_e and F_e of MODELS.md FE.5.3 for one element (no axial damping).
 #[inline]
 pub fn terms(mat: &Material, k: &MassCoefficients, s: &ElementState) -> ElementTerms {
@@ -294,6 +277,72 @@ pub fn terms_at_chord(
         fb,
         fl,
     }
+}
+
+/// The element's rows of R = M q'' − F (FE.9.3) at node accelerations a_a = `aa`, a_b = `ab` and
+/// l'' = `al` [m/s²], given its chord: (rows r_a, rows r_b, row l) [N]. The same function as
+/// M_e q''_e − F_e from [`terms_at_chord`], with FE.5.3's terms collected before they are summed
+/// (what the implicit residual evaluates twice per step):
+///
+/// ```text
+/// R_a = μ c1 (h a_a + h' l' a) + μ c2 (h a_b + h' l' b) + μ l'(α + β) b + (μ(α l'' + γ l'²/h) − N_t/|Δ|) Δ + ½ μ g h e_z
+/// R_b = μ c2 (h a_a + h' l' a) + μ c1 (h a_b + h' l' b) − μ l'(α + β) a + (μ(β l'' − γ l'²/h) + N_t/|Δ|) Δ + ½ μ g h e_z
+/// R_l = μ [Δ·(α a_a + β a_b) + (α a + β b)·Δ' + γ (|Δ|²/h (l'' − ½ h' l'²/h) + 2 l' Δ·Δ'/h)]
+///       − h' [½ μ (c1 (|a|² + |b|²) + 2 c2 a·b) + N (1 + ε⁺/2) + N_d (1 + ε) − ½ μ g (z_a + z_b)]
+/// ```
+///
+/// with N_t = N + N_d and Δ' = b − a: F_a's
+/// −μ α l' Δ' and −G share μ l' α a, which cancels, leaving μ l'(α + β) b (likewise for F_b),
+/// and the l-row's l'²|Δ|²/h² terms of M_ll's convective part and of ∂T/∂l combine into one.
+/// Fewer operations than forming M_e and F_e first; `implicit_residual_is_m_qdd_minus_f`
+/// checks the two agree to round-off.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn residual_at_chord(
+    mat: &Material,
+    k: &MassCoefficients,
+    s: &ElementState,
+    damping: f64,
+    chord: Chord,
+    aa: Vector2<f64>,
+    ab: Vector2<f64>,
+    al: f64,
+) -> (Vector2<f64>, Vector2<f64>, f64) {
+    let mu = mat.mu;
+    let (h, ld, inv_h) = (s.h, s.l_rate, s.inv_h);
+    let (a, b) = (s.va, s.vb);
+    let delta = s.rb - s.ra;
+    let len2 = delta.norm_squared();
+    let (strain, n) = s.tension(mat.ea, chord.length);
+    let (n_damp, _) = damping_tension(mat, s, damping);
+    let h_rate = s.h_prime * ld;
+    // (h a + h' l' a) and (h a_b + h' l' b): d(h r')/dt at each node.
+    let da = aa * h + a * h_rate;
+    let db = ab * h + b * h_rate;
+    let drift = mu * ld * (k.alpha + k.beta);
+    let pull = (n + n_damp) * chord.inv_length;
+    let centripetal = mu * k.gamma * ld * ld * inv_h;
+    let weight = Vector2::new(0.0, 0.5 * mu * mat.gravity * h);
+    let ra = (da * k.c1 + db * k.c2) * mu
+        + b * drift
+        + delta * (mu * k.alpha * al + centripetal - pull)
+        + weight;
+    let rb = (da * k.c2 + db * k.c1) * mu - a * drift
+        + delta * (mu * k.beta * al - centripetal + pull)
+        + weight;
+    let delta_rate = b - a;
+    let kinetic_density =
+        0.5 * mu * (k.c1 * (a.norm_squared() + b.norm_squared()) + 2.0 * k.c2 * a.dot(&b));
+    let rl = mu
+        * (delta.dot(&(aa * k.alpha + ab * k.beta))
+            + (a * k.alpha + b * k.beta).dot(&delta_rate)
+            + k.gamma
+                * (len2 * inv_h * (al - 0.5 * h_rate * ld * inv_h)
+                    + 2.0 * ld * inv_h * delta.dot(&delta_rate)))
+        - s.h_prime
+            * (kinetic_density + n * (1.0 + 0.5 * strain.max(0.0)) + n_damp * (1.0 + strain)
+                - mu * mat.gravity * 0.5 * (s.ra.y + s.rb.y));
+    (ra, rb, rl)
 }
 
 /// Element energies of MODELS.md FE.4: (kinetic T_e, strain ½ EA h max(ε,0)², gravity

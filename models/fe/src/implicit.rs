@@ -1,20 +1,22 @@
 //! The FE model's second-order form for the implicit integrator (MODELS.md FE.9.3):
-//! R = M(q) q'' − F(q, q', T) summed element by element on the span loop the explicit assembly
-//! runs ([`Fe::for_each_span_element`](crate::Fe)), and the
+//! R = M(q) q'' − F(q, q', T) summed element by element (the span elements in lanes,
+//! [`crate::lanes`]), and the
 //! iteration matrix S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q element by element.
 //!
 //! Why element by element: the rows l_i are dense (every node of a span feeds its length's
 //! equation), so colouring the columns of the global matrix would need one residual per column,
 //! O(N²) per matrix. Each element's contribution, though, depends only on its own unknowns
 //! (r_a, r_b, l for a free element; ρ, l for the stored one), so differentiating the element kernel
-//! ([`element::terms_damped`], the axial damping of FE.5.7 included) in its 5 local unknowns and adding the 5 × 5 blocks gives the exact
+//! ([`element::residual_at_chord`], the one R sums, the axial damping of FE.5.7 included) in its
+//! 5 local unknowns and adding the 5 × 5 blocks gives the exact
 //! global pattern of FE.5.5 (block-tridiagonal with the border rows and columns) at O(N) cost.
 //! Central differences with δ = ε^(1/3)·max(|u|, 1e-2) are accurate to ~1e-10 relative (as in
 //! [`cdpr_core::second_order::ColouredDifferences`]), the position steps kept within a quarter
 //! of the element's stretch ([`cdpr_core::second_order::central_step`]); the derivative in q''
 //! is linear and exact.
 
-use crate::element::{self, ElementState};
+use crate::element::{self, Chord, ElementState};
+use crate::lanes::SpanRates;
 use crate::{E_OUT, Fe};
 use cdpr_core::second_order::{MatrixCost, SecondOrderForm, central_step, spring_round_off};
 use nalgebra::Vector2;
@@ -115,10 +117,16 @@ impl Fe {
                     q[4] / n,
                     1.0 / n,
                 );
-                let t =
-                    element::terms_damped(mat, &self.coefficients[e - 1], &s, self.axial_damping);
-                let (ra, rb, rl) =
-                    t.residual(Vector2::new(a[0], a[1]), Vector2::new(a[2], a[3]), a[4]);
+                let (ra, rb, rl) = element::residual_at_chord(
+                    mat,
+                    &self.coefficients[e - 1],
+                    &s,
+                    self.axial_damping,
+                    Chord::of(&s),
+                    Vector2::new(a[0], a[1]),
+                    Vector2::new(a[2], a[3]),
+                    a[4],
+                );
                 r.copy_from_slice(&[ra.x, ra.y, rb.x, rb.y, rl]);
             }
             Block::Stored { cable } => {
@@ -133,33 +141,45 @@ impl Fe {
                 );
                 [r[0], r[1]] = self.stored_rows(cable, &s, a[0], a[1]);
             }
-            Block::Rigid { .. } => {
-                r[0] = mat.mu * (self.modelled_length - q[0]) * a[0] - 0.5 * mat.mu * v[0] * v[0];
-            }
-            Block::Effector => {
-                r[0] = self.effector_mass * a[0];
-                r[1] = self.effector_mass * (a[1] + mat.gravity);
-            }
+            Block::Rigid { .. } => r[0] = self.rigid_stored_row(q[0], v[0], a[0]),
+            Block::Effector => [r[0], r[1]] = self.effector_rows(a[0], a[1]),
         }
         r
     }
 
+    /// Row l of R from the rigid stored cable, T_s = ½ μ (L0 − l) l'² (tension left out), at l,
+    /// l', l'' [N].
+    #[inline(always)]
+    fn rigid_stored_row(&self, l: f64, l_rate: f64, l_acceleration: f64) -> f64 {
+        let mu = self.material.mu;
+        mu * (self.modelled_length - l) * l_acceleration - 0.5 * mu * l_rate * l_rate
+    }
+
+    /// Rows (x_P, z_P) of R from the effector's own mass and weight at P'' = (a_x, a_z) [N].
+    #[inline(always)]
+    fn effector_rows(&self, a_x: f64, a_z: f64) -> [f64; 2] {
+        [
+            self.effector_mass * a_x,
+            self.effector_mass * (a_z + self.material.gravity),
+        ]
+    }
+
     /// Rows (ρ, l) of R from the elastic stored element `s` of `cable` (R = A + ρ e_out), at
     /// ρ'' = `a_rho`, l'' = `a_l`: the kernel's R-node terms projected on e_out (tension left out).
-    #[inline]
+    #[inline(always)]
     fn stored_rows(&self, cable: usize, s: &ElementState, a_rho: f64, a_l: f64) -> [f64; 2] {
         let e_out = Vector2::new(E_OUT[cable], 0.0);
-        let t = element::terms_damped(
+        let (r_reel, _, r_l) = element::residual_at_chord(
             &self.material,
             &self.stored_coefficients,
             s,
             self.axial_damping,
+            Chord::of(s),
+            e_out * a_rho,
+            Vector2::zeros(),
+            a_l,
         );
-        let m_rho_l = t.m_al.dot(&e_out);
-        [
-            t.m_diag * a_rho + m_rho_l * a_l - t.fa.dot(&e_out),
-            m_rho_l * a_rho + t.m_ll * a_l - t.fl,
-        ]
+        [r_reel.dot(&e_out), r_l]
     }
 
     /// The block's local unknowns from the global state; a fixed pulley node sits at A_i at rest.
@@ -306,31 +326,70 @@ impl SecondOrderForm for Fe {
         }
     }
 
-    /// R = M q'' − F summed element by element ([`crate::element::ElementTerms::residual`] on the
-    /// span pass the explicit assembly runs), then the stored cables, the effector and the
-    /// commanded tensions. Why not M q'' from the assembled system: scattering M into the
-    /// block form, clearing it and multiplying it out again is a second pass over every node
-    /// that the residual does not need (FE implicit paper run 0.1436 → 0.1420 s).
+    /// R = M q'' − F summed element by element: the span elements' rows
+    /// ([`element::residual_at_chord`]) computed in lanes ([`crate::lanes::ChainRows`]) and
+    /// summed here in span order, then the stored cables, the effector and the commanded
+    /// tensions. Why not M q'' from the assembled system: scattering M into the block form,
+    /// clearing it and multiplying it out again is a second pass over every node that the
+    /// residual does not need (FE implicit paper run 0.1436 → 0.1420 s). The rows collected
+    /// before they are summed and the lanes took it from 0.124 to 0.097 s (README).
     fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]) {
-        let (nn, np) = (self.chain_nodes(), self.positions_len());
-        self.update_chords(state);
+        let (n, nn, np) = (self.elements, self.chain_nodes(), self.positions_len());
         r.fill(0.0);
-        let node_acceleration = |j: usize| Vector2::new(qdd[j], qdd[nn + j]);
+        let spans = [0, 1].map(|cable| {
+            let span = self.span_of(state, cable);
+            SpanRates {
+                l_rate: span.l_rate,
+                h: span.h,
+                inv_h: span.inv_h,
+                h_prime: span.h_prime,
+                l_acceleration: qdd[self.l_index(cable)],
+            }
+        });
+        // The chain's x and z coordinates of a vector in q's layout (FE.5.1).
+        fn halves(v: &[f64], nn: usize) -> [&[f64]; 2] {
+            [&v[..nn], &v[nn..2 * nn]]
+        }
+        self.chain_rows.evaluate(
+            &self.material,
+            self.axial_damping,
+            spans,
+            [self.pulley(0), self.pulley(1)],
+            halves(state, nn),
+            halves(&state[np..], nn),
+            halves(qdd, nn),
+        );
+        let rows = &self.chain_rows;
+        let p = self.effector_index();
         for (cable, tension) in tensions.into_iter().enumerate() {
             let li = self.l_index(cable);
-            let l_acceleration = qdd[li];
-            let mut l_row = 0.0;
-            self.for_each_span_element(state, cable, |ja, jb, t| {
-                let aa = ja.map_or(Vector2::zeros(), node_acceleration);
-                let (ra, rb, rl) = t.residual(aa, node_acceleration(jb), l_acceleration);
-                if let Some(ja) = ja {
-                    r[ja] += ra.x;
-                    r[nn + ja] += ra.y;
+            // Elements 1 … N in span order. Node k's rows are element k's r_b plus element
+            // k + 1's r_a: r_b waits in a register for its partner instead of a store and a
+            // reload, so each row is written once. Element 1's r_a is the fixed pulley's.
+            let (mut pending, mut l_row) = (Vector2::zeros(), 0.0);
+            for e in 1..=n {
+                let (i, a) = rows.element(cable, e);
+                let (left, right) = (
+                    Vector2::new(rows.left_x[i], rows.left_z[i]),
+                    Vector2::new(rows.right_x[i], rows.right_z[i]),
+                );
+                let (ra, rb) = if cable == 0 {
+                    (left, right)
+                } else {
+                    (right, left)
+                };
+                if e > 1 {
+                    // Padded index a is chain node a − 1.
+                    let row = pending + ra;
+                    r[a - 1] = row.x;
+                    r[nn + a - 1] = row.y;
                 }
-                r[jb] += rb.x;
-                r[nn + jb] += rb.y;
-                l_row += rl;
-            });
+                pending = rb;
+                l_row += rows.l[i];
+            }
+            // Element N's r_b: the effector's rows, which both spans and the effector add to.
+            r[p] += pending.x;
+            r[nn + p] += pending.y;
             r[li] += l_row;
             // The stored cable; T_i pulls the reel end (F_ρ = +T_i) or, rigid, does the virtual
             // work −T_i δl_i.
@@ -341,26 +400,14 @@ impl SecondOrderForm for Fe {
                     r[li] += rows[1];
                 }
                 (None, None) => {
-                    let rows = self.block_residual(
-                        Block::Rigid { cable },
-                        &[state[li], 0.0, 0.0, 0.0, 0.0],
-                        &[state[np + li], 0.0, 0.0, 0.0, 0.0],
-                        &[qdd[li], 0.0, 0.0, 0.0, 0.0],
-                    );
-                    r[li] += rows[0] + tension;
+                    r[li] += self.rigid_stored_row(state[li], state[np + li], qdd[li]) + tension;
                 }
                 _ => unreachable!("ρ_i and the stored element exist together"),
             }
         }
-        let p = self.effector_index();
-        let rows = self.block_residual(
-            Block::Effector,
-            &[0.0; 5],
-            &[0.0; 5],
-            &[qdd[p], qdd[nn + p], 0.0, 0.0, 0.0],
-        );
-        r[p] += rows[0];
-        r[nn + p] += rows[1];
+        let [r_x, r_z] = self.effector_rows(qdd[p], qdd[nn + p]);
+        r[p] += r_x;
+        r[nn + p] += r_z;
     }
 
     fn iteration_matrix(

@@ -22,12 +22,13 @@
 pub mod chain;
 pub mod element;
 mod implicit;
+mod lanes;
 pub mod solve;
 mod statics;
 
 use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError};
 use cdpr_core::scenario::{FeMass, FeStored, Scenario};
-use element::{Chord, ElementState, ElementTerms, MassCoefficients, Material};
+use element::{Chord, ElementState, MassCoefficients, Material};
 use nalgebra::Vector2;
 use solve::ChainSystem;
 
@@ -94,10 +95,11 @@ pub struct Fe {
     border: usize,
     /// Assembled M, F and the solve's scratch (allocated once; taken out while assembling).
     system: ChainSystem,
-    /// The chain's chords (between consecutive chain nodes) and their inverses, per assembly or
-    /// implicit residual.
+    /// The chain's chords (between consecutive chain nodes) and their inverses, per assembly.
     chord_length: Vec<f64>,
     chord_inv_length: Vec<f64>,
+    /// The implicit residual's chain elements (fixed coefficients, rows per evaluation).
+    chain_rows: lanes::ChainRows,
 }
 
 impl Fe {
@@ -126,7 +128,8 @@ impl Fe {
                 let w = |k: usize| 1.0 - k as f64 / n as f64;
                 MassCoefficients::new(mass, w(e - 1), w(e))
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let chain_rows = lanes::ChainRows::new(n, &coefficients);
         let nodes = 2 * n - 1;
         let (border, l_index) = match stored {
             FeStored::Elastic => (4, [0, 2]),
@@ -152,6 +155,7 @@ impl Fe {
             system: ChainSystem::new(nodes, border, l_index),
             chord_length: vec![0.0; nodes - 1],
             chord_inv_length: vec![0.0; nodes - 1],
+            chain_rows,
         })
     }
 
@@ -286,8 +290,7 @@ impl Fe {
         ))
     }
 
-    /// Chord j of the chain from the last [`Self::update_chords`] (an assembly's or an implicit
-    /// residual's).
+    /// Chord j of the chain from the last [`Self::update_chords`] (an assembly's).
     #[inline]
     fn chord_at(&self, j: usize) -> Chord {
         Chord {
@@ -308,17 +311,17 @@ impl Fe {
         );
     }
 
-    /// Calls `add(j_a, j_b, M_e and F_e)` for the free elements e = 1 (at the pulley) … N of
-    /// `cable`'s span (FE.5.3), with their chain nodes (j_a: None for the pulley node): the one
-    /// loop both the explicit assembly and the implicit residual run. The chords must be `y`'s
-    /// ([`Self::update_chords`]). Internal iteration, inlined into each caller, so the element
-    /// terms stay in registers.
+    /// Calls `add(j_a, j_b, element, its mass coefficients, its chord)` for the free elements
+    /// e = 1 (at the pulley) … N of `cable`'s span (FE.5.3), with their chain nodes (j_a: None
+    /// for the pulley node): the explicit assembly's loop (the implicit residual runs its
+    /// elements in lanes, [`lanes`]). The chords must be `y`'s ([`Self::update_chords`]).
+    /// Internal iteration, inlined into the caller, so the element's terms stay in registers.
     #[inline(always)]
     fn for_each_span_element(
         &self,
         y: &[f64],
         cable: usize,
-        mut add: impl FnMut(Option<usize>, usize, &ElementTerms),
+        mut add: impl FnMut(Option<usize>, usize, &ElementState, &MassCoefficients, Chord),
     ) {
         for (e, (s, k)) in (1..=self.elements).zip(self.span(y, cable).zip(&self.coefficients)) {
             let ja = self.chain_index(cable, e - 1);
@@ -329,8 +332,7 @@ impl Fe {
                 Some(ja) => self.chord_at(ja.min(jb)),
                 None => Chord::of(&s),
             };
-            let t = element::terms_at_chord(&self.material, k, &s, self.axial_damping, chord);
-            add(ja, jb, &t);
+            add(ja, jb, &s, k, chord);
         }
     }
 
@@ -343,7 +345,8 @@ impl Fe {
         for cable in 0..2 {
             let lb = sys.l_index[cable];
             let col = 2 + 2 * cable;
-            self.for_each_span_element(y, cable, |ja, jb, t| {
+            self.for_each_span_element(y, cable, |ja, jb, s, k, chord| {
+                let t = &element::terms_at_chord(&mat, k, s, self.axial_damping, chord);
                 if let Some(ja) = ja {
                     sys.diag[ja] += t.m_diag;
                     sys.off[ja.min(jb)] += t.m_off;

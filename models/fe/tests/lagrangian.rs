@@ -380,10 +380,12 @@ proptest! {
     /// The implicit path's residual (FE.9.3), summed element by element, is M(q) q'' − F(q, q', T)
     /// of the explicit path's assembly (the M and F checked above against the Lagrangian), for
     /// both mass and stored variants, with and without axial damping. It checks the residual's
-    /// own bookkeeping (rows to indices, stored cables, effector, tensions), not the element
-    /// kernel both share. 1e-13 of the largest term
-    /// (|M q''| or |F|, ~100 N): the two sum the same products in different orders, so they
-    /// differ by a few ulps of it (a missing or wrongly signed term is O(1) of it).
+    /// own element kernel (`residual_at_chord`, FE.5.3's terms collected differently from the
+    /// assembly's `terms_at_chord`), its lanes (N = 1, 4, 10: 2, 8, 20 elements, partial and
+    /// whole vectors) and its bookkeeping (rows to indices, stored cables, effector, tensions).
+    /// 1e-13 of the largest term (|M q''| or |F|, ~100 N): the two sum the same physics in
+    /// different orders, so they differ by a few ulps of it (a missing or wrongly signed term,
+    /// or a cable's elements read the wrong way round, is O(1) of it).
     #[test]
     fn implicit_residual_is_m_qdd_minus_f(
         n in prop_oneof![Just(1usize), Just(4), Just(10)],
