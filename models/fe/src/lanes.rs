@@ -75,8 +75,9 @@ impl ChainRows {
         }
     }
 
-    /// Element i of the padded chain: element e of `cable` (1 … N), and the padded index of
-    /// its node a (the pulley node of e = 1 is 0 for cable 1, 2N for cable 2).
+    /// Where element e (1 … N) of `cable` sits in the padded chain: its index i, and the padded
+    /// index of its node a (for e = 1 the pulley: 0 for cable 1, 2N for cable 2; chain node j is
+    /// padded node j + 1).
     #[inline]
     pub fn element(&self, cable: usize, e: usize) -> (usize, usize) {
         let n = self.split;
