@@ -16,7 +16,6 @@
 //! is linear and exact.
 
 use crate::element::{self, Chord, ElementState};
-use crate::lanes::SpanRates;
 use crate::{E_OUT, Fe};
 use cdpr_core::second_order::{MatrixCost, SecondOrderForm, central_step, spring_round_off};
 use nalgebra::Vector2;
@@ -336,16 +335,8 @@ impl SecondOrderForm for Fe {
     fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]) {
         let (n, nn, np) = (self.elements, self.chain_nodes(), self.positions_len());
         r.fill(0.0);
-        let spans = [0, 1].map(|cable| {
-            let span = self.span_of(state, cable);
-            SpanRates {
-                l_rate: span.l_rate,
-                h: span.h,
-                inv_h: span.inv_h,
-                h_prime: span.h_prime,
-                l_acceleration: qdd[self.l_index(cable)],
-            }
-        });
+        let spans = [self.span_of(state, 0), self.span_of(state, 1)];
+        let l_accelerations = [0, 1].map(|cable| qdd[self.l_index(cable)]);
         // The chain's x and z coordinates of a vector in q's layout (FE.5.1).
         fn halves(v: &[f64], nn: usize) -> [&[f64]; 2] {
             [&v[..nn], &v[nn..2 * nn]]
@@ -353,7 +344,8 @@ impl SecondOrderForm for Fe {
         self.chain_rows.evaluate(
             &self.material,
             self.axial_damping,
-            spans,
+            [&spans[0], &spans[1]],
+            l_accelerations,
             [self.pulley(0), self.pulley(1)],
             halves(state, nn),
             halves(&state[np..], nn),
@@ -368,23 +360,13 @@ impl SecondOrderForm for Fe {
             // reload, so each row is written once. Element 1's r_a is the fixed pulley's.
             let (mut pending, mut l_row) = (Vector2::zeros(), 0.0);
             for e in 1..=n {
-                let (i, a) = rows.element(cable, e);
-                let (left, right) = (
-                    Vector2::new(rows.left_x[i], rows.left_z[i]),
-                    Vector2::new(rows.right_x[i], rows.right_z[i]),
-                );
-                let (ra, rb) = if cable == 0 {
-                    (left, right)
-                } else {
-                    (right, left)
-                };
-                if e > 1 {
-                    // Padded index a is chain node a − 1.
-                    let row = pending + ra;
-                    r[a - 1] = row.x;
-                    r[nn + a - 1] = row.y;
+                let i = rows.element(cable, e);
+                if let Some(ja) = self.chain_index(cable, e - 1) {
+                    let row = pending + Vector2::new(rows.a_x[i], rows.a_z[i]);
+                    r[ja] = row.x;
+                    r[nn + ja] = row.y;
                 }
-                pending = rb;
+                pending = Vector2::new(rows.b_x[i], rows.b_z[i]);
                 l_row += rows.l[i];
             }
             // Element N's r_b: the effector's rows, which both spans and the effector add to.

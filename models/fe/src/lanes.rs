@@ -15,18 +15,9 @@
 //! after another waits on its chord's square root and division; four elements in lanes use the
 //! vector width the scalar code leaves idle (FE implicit paper run: see the README's table).
 
+use crate::Span;
 use crate::element::{self, Chord, ElementState, MassCoefficients, Material};
 use nalgebra::Vector2;
-
-/// What the N free elements of one span share (FE.3): l', h = l/N, 1/h, h' = 1/N, and l''.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct SpanRates {
-    pub l_rate: f64,
-    pub h: f64,
-    pub inv_h: f64,
-    pub h_prime: f64,
-    pub l_acceleration: f64,
-}
 
 /// The span elements' fixed mass coefficients, the nodes they read and their rows of R, in chain
 /// order with the pulley nodes at its ends (allocated once).
@@ -41,11 +32,11 @@ pub(crate) struct ChainRows {
     gamma: Vec<f64>,
     /// Node positions, velocities and accelerations (x, z each): pulley 1, the chain, pulley 2.
     nodes: [Vec<f64>; 6],
-    /// Rows (x, z) of element i's left node i and right node i + 1, and its row l [N].
-    pub left_x: Vec<f64>,
-    pub left_z: Vec<f64>,
-    pub right_x: Vec<f64>,
-    pub right_z: Vec<f64>,
+    /// Rows (x, z) of element i's node a and node b, and its row l [N].
+    pub a_x: Vec<f64>,
+    pub a_z: Vec<f64>,
+    pub b_x: Vec<f64>,
+    pub b_z: Vec<f64>,
     pub l: Vec<f64>,
 }
 
@@ -67,35 +58,33 @@ impl ChainRows {
             beta: column(|k| k.beta),
             gamma: column(|k| k.gamma),
             nodes: std::array::from_fn(|_| vec![0.0; m + 1]),
-            left_x: vec![0.0; m],
-            left_z: vec![0.0; m],
-            right_x: vec![0.0; m],
-            right_z: vec![0.0; m],
+            a_x: vec![0.0; m],
+            a_z: vec![0.0; m],
+            b_x: vec![0.0; m],
+            b_z: vec![0.0; m],
             l: vec![0.0; m],
         }
     }
 
-    /// Where element e (1 … N) of `cable` sits in the padded chain: its index i, and the padded
-    /// index of its node a (for e = 1 the pulley: 0 for cable 1, 2N for cable 2; chain node j is
-    /// padded node j + 1).
+    /// Index in the padded chain of element e (1 … N) of `cable`.
     #[inline]
-    pub fn element(&self, cable: usize, e: usize) -> (usize, usize) {
-        let n = self.split;
+    pub fn element(&self, cable: usize, e: usize) -> usize {
         match cable {
-            0 => (e - 1, e - 1),
-            _ => (2 * n - e, 2 * n + 1 - e),
+            0 => e - 1,
+            _ => 2 * self.split - e,
         }
     }
 
     /// The rows of every span element for chain-node positions (x, z), velocities (v_x, v_z)
-    /// and accelerations (a_x, a_z) (in q's layout, FE.5.1), the pulleys A_1, A_2 and each
-    /// cable's span.
+    /// and accelerations (a_x, a_z) (in q's layout, FE.5.1), the pulleys A_1, A_2, and each
+    /// cable's span and l''.
     #[allow(clippy::too_many_arguments)]
     pub fn evaluate(
         &mut self,
         mat: &Material,
         damping: f64,
-        spans: [SpanRates; 2],
+        spans: [&Span; 2],
+        l_accelerations: [f64; 2],
         pulleys: [Vector2<f64>; 2],
         positions: [&[f64]; 2],
         velocities: [&[f64]; 2],
@@ -119,14 +108,20 @@ impl ChainRows {
         // becomes a select, which would evaluate the damping terms' square root and divisions
         // on every element.
         if damping == 0.0 {
-            self.evaluate_with(mat, 0.0, spans);
+            self.evaluate_with(mat, 0.0, spans, l_accelerations);
         } else {
-            self.evaluate_with(mat, damping, spans);
+            self.evaluate_with(mat, damping, spans, l_accelerations);
         }
     }
 
     #[inline(always)]
-    fn evaluate_with(&mut self, mat: &Material, damping: f64, spans: [SpanRates; 2]) {
+    fn evaluate_with(
+        &mut self,
+        mat: &Material,
+        damping: f64,
+        [s1, s2]: [&Span; 2],
+        [l1, l2]: [f64; 2],
+    ) {
         let m = self.l.len();
         // Every slice cut to its length here, so the loop carries no bounds checks.
         let [x, z, vx, vz, ax, az] = &self.nodes;
@@ -145,14 +140,13 @@ impl ChainRows {
             &self.beta[..m],
             &self.gamma[..m],
         );
-        let (left_x, left_z, right_x, right_z, l_rows) = (
-            &mut self.left_x[..m],
-            &mut self.left_z[..m],
-            &mut self.right_x[..m],
-            &mut self.right_z[..m],
+        let (a_x, a_z, b_x, b_z, l_rows) = (
+            &mut self.a_x[..m],
+            &mut self.a_z[..m],
+            &mut self.b_x[..m],
+            &mut self.b_z[..m],
             &mut self.l[..m],
         );
-        let [s1, s2] = spans;
         for i in 0..m {
             let first = i < self.split;
             let pick = |p: f64, q: f64| if first { p } else { q };
@@ -190,14 +184,13 @@ impl ChainRows {
                 beta: beta[i],
                 gamma: gamma[i],
             };
-            let l_acceleration = pick(s1.l_acceleration, s2.l_acceleration);
+            let l_acceleration = pick(l1, l2);
             let (ra, rb, rl) =
                 element::residual_at_chord(mat, &k, &s, damping, chord, a.2, b.2, l_acceleration);
-            let (on_left, on_right) = if first { (ra, rb) } else { (rb, ra) };
-            left_x[i] = on_left.x;
-            left_z[i] = on_left.y;
-            right_x[i] = on_right.x;
-            right_z[i] = on_right.y;
+            a_x[i] = ra.x;
+            a_z[i] = ra.y;
+            b_x[i] = rb.x;
+            b_z[i] = rb.y;
             l_rows[i] = rl;
         }
     }
@@ -239,19 +232,19 @@ mod tests {
             }
             let span = |c: usize| {
                 let l = 0.5 + 0.1 * values[150 + c];
-                SpanRates {
+                Span {
                     l_rate: values[152 + c],
                     h: l / n as f64,
                     inv_h: 1.0 / (l / n as f64),
                     h_prime: 1.0 / n as f64,
-                    l_acceleration: values[154 + c],
                 }
             };
             let spans = [span(0), span(1)];
+            let l_accelerations = [values[154], values[155]];
             let pulleys = [Vector2::new(0.0, 0.0), Vector2::new(1.0, 0.0)];
             let mut rows = ChainRows::new(n, &coefficients);
             let part = |k: usize| -> [&[f64]; 2] { [&q[2 * k * nn..(2 * k + 1) * nn], &q[(2 * k + 1) * nn..(2 * k + 2) * nn]] };
-            rows.evaluate(&mat, damping, spans, pulleys, part(0), part(1), part(2));
+            rows.evaluate(&mat, damping, [&spans[0], &spans[1]], l_accelerations, pulleys, part(0), part(1), part(2));
             // Node k of cable c (0: the pulley) as (r, v, a), read from q directly.
             let node = |c: usize, k: usize| {
                 if k == 0 {
@@ -269,12 +262,11 @@ mod tests {
                         l_rate: sp.l_rate, h: sp.h, inv_h: sp.inv_h, h_prime: sp.h_prime,
                     };
                     let (ra, rb, rl) = element::residual_at_chord(
-                        &mat, &coefficients[e - 1], &s, damping, Chord::of(&s), a.2, b.2, sp.l_acceleration,
+                        &mat, &coefficients[e - 1], &s, damping, Chord::of(&s), a.2, b.2, l_accelerations[c],
                     );
-                    let (i, _) = rows.element(c, e);
-                    let left = Vector2::new(rows.left_x[i], rows.left_z[i]);
-                    let right = Vector2::new(rows.right_x[i], rows.right_z[i]);
-                    let (la, lb) = if c == 0 { (left, right) } else { (right, left) };
+                    let i = rows.element(c, e);
+                    let la = Vector2::new(rows.a_x[i], rows.a_z[i]);
+                    let lb = Vector2::new(rows.b_x[i], rows.b_z[i]);
                     let same = |u: Vector2<f64>, v: Vector2<f64>| u.x.to_bits() == v.x.to_bits() && u.y.to_bits() == v.y.to_bits();
                     prop_assert!(same(la, ra) && same(lb, rb), "cable {c} element {e}: {la:?} {lb:?} vs {ra:?} {rb:?}");
                     prop_assert_eq!(rows.l[i].to_bits(), rl.to_bits(), "cable {} element {}", c, e);

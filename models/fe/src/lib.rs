@@ -17,7 +17,8 @@
 //!
 //! Per right-hand side: assemble M(q) and F(q, q', T) element by element ([`element::terms`]), then
 //! the O(N) block solve of FE.5.5 ([`solve::ChainSystem`]); nothing is allocated. The implicit
-//! path's residual M q'' − F sums the same element terms without assembling (`implicit`).
+//! path's residual M q'' − F sums each element's rows without assembling
+//! ([`element::residual_at_chord`], the span elements in lanes).
 
 pub mod chain;
 pub mod element;
@@ -290,7 +291,7 @@ impl Fe {
         ))
     }
 
-    /// Chord j of the chain from the last [`Self::update_chords`] (an assembly's).
+    /// Chord j of the chain from the last assembly's pass.
     #[inline]
     fn chord_at(&self, j: usize) -> Chord {
         Chord {
@@ -299,9 +300,12 @@ impl Fe {
         }
     }
 
-    /// The chain's chords from positions `y` into the pass [`Self::for_each_span_element`] reads.
-    #[inline]
-    fn update_chords(&mut self, y: &[f64]) {
+    /// Assembles M(q) and F(q, q', T) (FE.5.3) into the block system of FE.5.5.
+    fn assemble(&mut self, y: &[f64], tensions: [f64; 2]) {
+        let mut sys = std::mem::take(&mut self.system);
+        sys.clear();
+        let n = self.elements;
+        let mat = self.material;
         let nn = self.chain_nodes();
         element::chords(
             &y[..nn],
@@ -309,44 +313,19 @@ impl Fe {
             &mut self.chord_length,
             &mut self.chord_inv_length,
         );
-    }
-
-    /// Calls `add(j_a, j_b, element, its mass coefficients, its chord)` for the free elements
-    /// e = 1 (at the pulley) … N of `cable`'s span (FE.5.3), with their chain nodes (j_a: None
-    /// for the pulley node): the explicit assembly's loop (the implicit residual runs its
-    /// elements in lanes, [`lanes`]). The chords must be `y`'s ([`Self::update_chords`]).
-    /// Internal iteration, inlined into the caller, so the element's terms stay in registers.
-    #[inline(always)]
-    fn for_each_span_element(
-        &self,
-        y: &[f64],
-        cable: usize,
-        mut add: impl FnMut(Option<usize>, usize, &ElementState, &MassCoefficients, Chord),
-    ) {
-        for (e, (s, k)) in (1..=self.elements).zip(self.span(y, cable).zip(&self.coefficients)) {
-            let ja = self.chain_index(cable, e - 1);
-            let jb = self.chain_index(cable, e).expect("node e ≥ 1 is free");
-            // An element between chain nodes j, j + 1 has chord j of the pass; element 1 starts
-            // at the pulley, which is not a chain node.
-            let chord = match ja {
-                Some(ja) => self.chord_at(ja.min(jb)),
-                None => Chord::of(&s),
-            };
-            add(ja, jb, &s, k, chord);
-        }
-    }
-
-    /// Assembles M(q) and F(q, q', T) (FE.5.3) into the block system of FE.5.5.
-    fn assemble(&mut self, y: &[f64], tensions: [f64; 2]) {
-        let mut sys = std::mem::take(&mut self.system);
-        sys.clear();
-        let mat = self.material;
-        self.update_chords(y);
         for cable in 0..2 {
             let lb = sys.l_index[cable];
             let col = 2 + 2 * cable;
-            self.for_each_span_element(y, cable, |ja, jb, s, k, chord| {
-                let t = &element::terms_at_chord(&mat, k, s, self.axial_damping, chord);
+            for (e, (s, k)) in (1..=n).zip(self.span(y, cable).zip(&self.coefficients)) {
+                let ja = self.chain_index(cable, e - 1);
+                let jb = self.chain_index(cable, e).expect("node e ≥ 1 is free");
+                // An element between chain nodes j, j + 1 has chord j of the pass; element 1
+                // starts at the pulley, which is not a chain node.
+                let chord = match ja {
+                    Some(ja) => self.chord_at(ja.min(jb)),
+                    None => Chord::of(&s),
+                };
+                let t = element::terms_at_chord(&mat, k, &s, self.axial_damping, chord);
                 if let Some(ja) = ja {
                     sys.diag[ja] += t.m_diag;
                     sys.off[ja.min(jb)] += t.m_off;
@@ -364,7 +343,7 @@ impl Fe {
                 r[col + 1] += t.m_bl.y;
                 sys.d[lb][lb] += t.m_ll;
                 sys.f_border[lb] += t.fl;
-            });
+            }
             let li = self.l_index(cable);
             match self.stored_element(y, cable) {
                 Some(s) => {
