@@ -1,10 +1,11 @@
 //! Cost of the elastic model: one closed-loop RHS evaluation, and the 5 s paper run with its
 //! 500 001 output samples (and without them, to show what integration alone costs).
 
-use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate, simulate_reusing};
-use cdpr_core::integrate::OdeSystem;
-use cdpr_core::scenario::Scenario;
-use cdpr_elastic::Elastic;
+use cdpr_bench::core::closed_loop::ClosedLoop;
+use cdpr_bench::core::runner::{RunOptions, simulate, simulate_reusing};
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::elastic::Elastic;
+use cdpr_bench::numerics::OdeSystem;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 

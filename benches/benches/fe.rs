@@ -2,23 +2,18 @@
 //! evaluation, the assembly of M and F alone and with the O(N) block solve of MODELS.md FE.5.5, and
 //! the 5 s paper run with DOPRI5 (about 1.6 M accepted steps and 11.7 M RHS evaluations).
 
-use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate};
-use cdpr_core::integrate::OdeSystem;
-use cdpr_core::scenario::{ModelKind, Scenario};
-use cdpr_fe::Fe;
+use cdpr_bench::core::closed_loop::ClosedLoop;
+use cdpr_bench::core::runner::{RunOptions, simulate};
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::fe::{Fe, Params};
+use cdpr_bench::numerics::OdeSystem;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::time::Duration;
 
-fn scenario() -> Scenario {
-    let mut s = Scenario::paper();
-    s.model.kind = ModelKind::Fe;
-    s
-}
-
 fn rhs(c: &mut Criterion) {
-    let scenario = scenario();
-    let mut sys = ClosedLoop::new(Fe::new(&scenario).unwrap(), &scenario);
+    let scenario = Scenario::paper();
+    let mut sys = ClosedLoop::new(Fe::new(&scenario, Params::default()).unwrap(), &scenario);
     let (mut y, _) = sys.initial_state().unwrap();
     // Moving cable: every velocity term of the assembly is exercised.
     let np = sys.model.positions_len();
@@ -32,7 +27,7 @@ fn rhs(c: &mut Criterion) {
             black_box(&dy);
         })
     });
-    let mut model = Fe::new(&scenario).unwrap();
+    let mut model = Fe::new(&scenario, Params::default()).unwrap();
     let mut qdd = vec![0.0; np];
     c.bench_function("fe/assemble", |b| {
         b.iter(|| {
@@ -50,7 +45,7 @@ fn rhs(c: &mut Criterion) {
 }
 
 fn paper_run(c: &mut Criterion) {
-    let scenario = scenario();
+    let scenario = Scenario::paper();
     let opts = RunOptions::from(&scenario);
     let mut group = c.benchmark_group("fe");
     group
@@ -58,7 +53,8 @@ fn paper_run(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(240));
     group.bench_function("paper_run_5s", |b| {
         b.iter(|| {
-            let mut sys = ClosedLoop::new(Fe::new(&scenario).unwrap(), &scenario);
+            let mut sys =
+                ClosedLoop::new(Fe::new(&scenario, Params::default()).unwrap(), &scenario);
             let run = simulate(&mut sys, &opts, &mut |_| {}).unwrap();
             black_box(run.stats.rhs_evals)
         })

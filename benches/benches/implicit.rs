@@ -12,20 +12,23 @@
 //! `CDPR_BENCH_T=0.002` (simulated time of the cost-vs-N runs [s]) and `CDPR_BENCH_STATS=1`
 //! (print each case's solver counters before timing it).
 
-use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate_from, simulate_reusing};
-use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{IntegratorKind, ModelKind, Scenario};
-use cdpr_core::series::TimeSeries;
-use cdpr_fe::Fe;
-use cdpr_lumped::Lumped;
+use cdpr_bench::core::closed_loop::ClosedLoop;
+use cdpr_bench::core::model::CableModel;
+use cdpr_bench::core::runner::{RunOptions, simulate_from, simulate_reusing};
+use cdpr_bench::core::scenario::{IntegratorKind, Scenario};
+use cdpr_bench::core::series::TimeSeries;
+use cdpr_bench::{ModelConfig, ModelKind, ModelVisitor, build, with_model};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::time::Duration;
 
 fn scenario(kind: ModelKind, elements: Option<i64>) -> Scenario {
     let mut s = Scenario::paper();
-    s.model.kind = kind;
-    s.model.elements = elements;
+    s.model = ModelConfig {
+        elements,
+        ..ModelConfig::of_kind(kind)
+    }
+    .into();
     s.simulation.integrator = IntegratorKind::Implicit;
     s
 }
@@ -43,7 +46,7 @@ fn paper_runs(c: &mut Criterion) {
             let mut buffer = Vec::new();
             group.bench_function(format!("{kind}_paper_run_5s{label}"), |b| {
                 b.iter(|| {
-                    let model = boxed_model(&s);
+                    let model = build(&s).unwrap();
                     let mut sys = ClosedLoop::new(model, &s);
                     let run =
                         simulate_reusing(&mut sys, &opts, std::mem::take(&mut buffer), &mut |_| {})
@@ -58,44 +61,51 @@ fn paper_runs(c: &mut Criterion) {
     group.finish();
 }
 
-/// The scenario's massive-cable model, boxed (the benches crate does not depend on cdpr-verify).
-fn boxed_model(s: &Scenario) -> Box<dyn CableModel + Send> {
-    match s.model.kind {
-        ModelKind::Lumped => Box::new(Lumped::new(s).unwrap()),
-        _ => Box::new(Fe::new(s).unwrap()),
-    }
-}
-
 /// 0.02 s of the paper's run from the static equilibrium at x_ref(0) (solved once, outside the
 /// timing), with a fresh copy of the model per iteration (the lumped model's stored counts change
 /// at pulley events).
 fn bench_from<M: CableModel + Clone>(
     group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     s: &Scenario,
+    kind: ModelKind,
+    n: i64,
     model: M,
 ) {
     let opts = RunOptions::from(s);
     let mut sys = ClosedLoop::new(model, s);
     let (y0, eq) = sys.initial_state().unwrap();
     let start = sys.model.clone();
-    let n = s.model.elements();
     if std::env::var_os("CDPR_BENCH_STATS").is_some() {
         let run = simulate_from(&mut sys, y0.clone(), eq.clone(), &opts, &mut |_| {}).unwrap();
         eprintln!(
-            "{} N = {n}: {:?}, {} events, {:.4} s",
-            s.model.kind,
+            "{kind} N = {n}: {:?}, {} events, {:.4} s",
             run.stats,
             run.events.len(),
             run.wall_s
         );
     }
-    group.bench_with_input(BenchmarkId::new(s.model.kind.name(), n), &n, |b, _| {
+    group.bench_with_input(BenchmarkId::new(kind.name(), n), &n, |b, _| {
         b.iter(|| {
             sys.model = start.clone();
             let run = simulate_from(&mut sys, y0.clone(), eq.clone(), &opts, &mut |_| {}).unwrap();
             black_box(TimeSeries::len(&run.series))
         })
     });
+}
+
+/// [`bench_from`] on the scenario's model, whichever it is.
+struct BenchFrom<'a, 'g> {
+    group: &'a mut criterion::BenchmarkGroup<'g, criterion::measurement::WallTime>,
+    s: &'a Scenario,
+    kind: ModelKind,
+    n: i64,
+}
+
+impl ModelVisitor for BenchFrom<'_, '_> {
+    type Output = ();
+    fn visit<M: CableModel + Clone + Send + 'static>(self, model: M) {
+        bench_from(self.group, self.s, self.kind, self.n, model)
+    }
 }
 
 fn cost_vs_n(c: &mut Criterion) {
@@ -117,10 +127,13 @@ fn cost_vs_n(c: &mut Criterion) {
                 .and_then(|v| v.parse().ok())
                 .unwrap_or(0.02);
             s.simulation.sample_period = 1e-4;
-            match kind {
-                ModelKind::Lumped => bench_from(&mut group, &s, Lumped::new(&s).unwrap()),
-                _ => bench_from(&mut group, &s, Fe::new(&s).unwrap()),
-            }
+            let bench = BenchFrom {
+                group: &mut group,
+                s: &s,
+                kind,
+                n,
+            };
+            with_model(&s, bench).unwrap();
         }
     }
     group.finish();

@@ -7,7 +7,7 @@
 //!   x(s) = H s/EA + (H/w) [asinh((V0 + w s)/H) − asinh(V0/H)]
 //!   z(s) = (V0 s + w s²/2)/EA + (1/w) [√(H² + (V0 + w s)²) − √(H² + V0²)]
 
-use cdpr_core::statics::{self, NewtonError, NewtonOptions, StaticProblem};
+use cdpr_bench::numerics::newton::{self, NewtonError, NewtonOptions, StaticProblem};
 
 /// An elastic catenary hanging from the origin.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -67,7 +67,7 @@ impl Catenary {
             axial_stiffness,
         };
         let mut u = [h0, v0];
-        statics::solve(
+        newton::solve(
             &mut problem,
             &mut u,
             NewtonOptions {

@@ -2,9 +2,9 @@
 //! fixed unstrained length between fixed ends, N elements, nodes compared with the catenary at the
 //! same unstrained arc length s_k = k L0/N.
 
-use cdpr_core::Vector2;
-use cdpr_fe::chain::FixedCable;
-use cdpr_fe::element::Material;
+use cdpr_bench::core::Vector2;
+use cdpr_bench::fe::chain::FixedCable;
+use cdpr_bench::fe::element::Material;
 use cdpr_verify::irvine::Catenary;
 
 const MU: f64 = 0.013816;

@@ -4,15 +4,19 @@
 //! the effector trajectory against the Dormand–Prince reference within a bound derived from the
 //! step.
 
-use cdpr_core::integrate::AlphaCoefficients;
-use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{FeStored, IntegratorKind, ModelKind, Scenario};
-use cdpr_verify::{acceptance, assess, model, simulate};
+use cdpr_bench::ModelKind;
+use cdpr_bench::core::channel::Channel;
+use cdpr_bench::core::model::CableModel;
+use cdpr_bench::core::scenario::{IntegratorKind, Scenario};
+use cdpr_bench::fe::FeStored;
+use cdpr_bench::numerics::AlphaCoefficients;
+use cdpr_bench::{ModelConfig, assess, build as model, simulate};
+use cdpr_verify::acceptance;
 use proptest::prelude::*;
 
 fn paper(kind: ModelKind, integrator: IntegratorKind) -> Scenario {
     let mut s = Scenario::paper();
-    s.model.kind = kind;
+    s.model = kind.into();
     s.simulation.integrator = integrator;
     s
 }
@@ -41,7 +45,11 @@ fn check_iteration_matrix(
 ) {
     let mut scenario = paper(kind, IntegratorKind::Implicit);
     scenario.cable.axial_damping = damping;
-    scenario.model.fe_stored = fe_stored;
+    scenario.model = ModelConfig {
+        fe_stored,
+        ..ModelConfig::of_kind(kind)
+    }
+    .into();
     let mut m = model(&scenario).unwrap();
     let eq = m.equilibrium(x, scenario.controller.tension_sum).unwrap();
     let form = m.second_order_mut().unwrap();
@@ -145,9 +153,9 @@ proptest! {
 /// 0.158 -> 0.148 s), so the kept layout has exactly those three in its border.
 #[test]
 fn paper_iteration_matrices_keep_the_cheapest_layout() {
-    use cdpr_core::closed_loop::ClosedLoop;
-    use cdpr_core::integrate::SecondOrderSystem;
-    use cdpr_core::integrate::sparse::IterationMatrix;
+    use cdpr_bench::core::closed_loop::ClosedLoop;
+    use cdpr_bench::numerics::SecondOrderSystem;
+    use cdpr_bench::numerics::sparse::IterationMatrix;
     for kind in [ModelKind::Lumped, ModelKind::Fe] {
         let scenario = paper(kind, IntegratorKind::Implicit);
         let mut sys = ClosedLoop::new(model(&scenario).unwrap(), &scenario);
@@ -208,7 +216,8 @@ fn implicit_paper_runs_meet_section_8_and_track_dormand_prince() {
         let lumped_fine = scope.spawn(|| {
             let mut s = paper(ModelKind::Lumped, IntegratorKind::Implicit);
             s.simulation.step = FINE_STEP;
-            assess(&s, &mut |_| {}).unwrap()
+            let outcome = assess(&s, &mut |_| {}).unwrap();
+            (outcome, s)
         });
         let implicit: Vec<_> = kinds
             .iter()
@@ -241,7 +250,8 @@ fn implicit_paper_runs_meet_section_8_and_track_dormand_prince() {
         )
     });
     let is_hf = |c: &acceptance::Check| c.quantity.starts_with("high-frequency");
-    let fine_hf: Vec<_> = acceptance::model_checks(&lumped_fine.result())
+    let (lumped_fine, fine_scenario) = &lumped_fine;
+    let fine_hf: Vec<_> = acceptance::model_checks(&acceptance::result(lumped_fine, fine_scenario))
         .into_iter()
         .filter(is_hf)
         .collect();
@@ -249,7 +259,10 @@ fn implicit_paper_runs_meet_section_8_and_track_dormand_prince() {
     assert!(fine_hf.iter().all(|c| c.pass), "{fine_hf:#?}");
     let sim = &Scenario::paper().simulation;
     for (run, dp) in implicit.iter().zip(&reference) {
-        let rows = acceptance::model_checks(&run.result());
+        let rows = acceptance::model_checks(&acceptance::result(
+            run,
+            &paper(run.kind, IntegratorKind::Implicit),
+        ));
         for c in rows.iter().filter(|c| is_hf(c)) {
             eprintln!("{}, h = {} s: {} ({})", run.kind, sim.step, c.ours, c.pass);
         }
@@ -304,7 +317,7 @@ fn implicit_paper_runs_meet_section_8_and_track_dormand_prince() {
         // ~2.5e-6 s, far more accurate than that (MODELS.md FE.9.3 measures 7e-9 m between them).
         let e_max = dp
             .series
-            .column("error")
+            .column(Channel::Error)
             .unwrap()
             .iter()
             .fold(0.0f64, |a, v| a.max(v.abs()));
@@ -339,12 +352,12 @@ fn implicit_paper_runs_meet_section_8_and_track_dormand_prince() {
         let bound = bound + peak_speed * event_shift;
         let samples = dp
             .series
-            .column("t")
+            .column(Channel::Time)
             .unwrap()
             .iter()
             .take_while(|t| **t < synchronised_until)
             .count();
-        for channel in ["x", "z"] {
+        for channel in [Channel::X, Channel::Z] {
             let ours = &run.run.series.column(channel).unwrap()[..samples];
             let theirs = &dp.series.column(channel).unwrap()[..samples];
             let diff = max_difference(ours, theirs);

@@ -2,11 +2,13 @@
 //! the discrete taut-string frequencies (dynamics), and the massless elastic model in the limit of
 //! a vanishing cable density.
 
-use cdpr_core::Vector2;
-use cdpr_core::scenario::{ModelKind, Scenario};
-use cdpr_lumped::chain::Chain;
+use cdpr_bench::ModelKind;
+use cdpr_bench::core::Vector2;
+use cdpr_bench::core::channel::Channel;
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::lumped::chain::Chain;
+use cdpr_bench::{ModelConfig, simulate};
 use cdpr_verify::irvine::Catenary;
-use cdpr_verify::simulate;
 use faer::{Mat, Side};
 use proptest::prelude::*;
 
@@ -170,8 +172,11 @@ proptest! {
 fn lumped_tends_to_elastic_as_density_vanishes() {
     let base = |kind: ModelKind, density: f64| {
         let mut s = Scenario::paper();
-        s.model.kind = kind;
-        s.model.elements = Some(10);
+        s.model = ModelConfig {
+            elements: Some(10),
+            ..ModelConfig::of_kind(kind)
+        }
+        .into();
         s.cable.density = density;
         s.simulation.t_final = 0.3;
         s.simulation.sample_period = 1e-4;
@@ -181,14 +186,14 @@ fn lumped_tends_to_elastic_as_density_vanishes() {
     };
     let elastic = simulate(&base(ModelKind::Elastic, 7850.0), &mut |_| {}).unwrap();
     let (xe, ze) = (
-        elastic.series.column("x").unwrap(),
-        elastic.series.column("z").unwrap(),
+        elastic.series.column(Channel::X).unwrap(),
+        elastic.series.column(Channel::Z).unwrap(),
     );
     let difference = |density: f64| {
         let lumped = simulate(&base(ModelKind::Lumped, density), &mut |_| {}).unwrap();
         let (xl, zl) = (
-            lumped.series.column("x").unwrap(),
-            lumped.series.column("z").unwrap(),
+            lumped.series.column(Channel::X).unwrap(),
+            lumped.series.column(Channel::Z).unwrap(),
         );
         let worst = |a: &[f64], b: &[f64]| {
             a.iter()

@@ -5,22 +5,27 @@
 //! (MODELS.md §4) predicted by the linearisation against a DP45 run of the nonlinear model.
 //! (Eigenvalues of a linear test system against closed form: `cdpr-core`'s `modal` tests.)
 
-use cdpr_core::Vector2;
-use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate_from};
-use cdpr_core::integrate::{Dopri5Options, OdeSystem};
-use cdpr_core::modal;
-use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{ModelKind, Scenario};
-use cdpr_core::trajectory::Step5;
-use cdpr_elastic::Elastic;
-use cdpr_lumped::Lumped;
-use cdpr_lumped::chain::Chain;
-use cdpr_verify::modes::{self, Loop, ModeKind};
+use cdpr_bench::ModelKind;
+use cdpr_bench::analysis::modes::{self, Loop, ModeKind};
+use cdpr_bench::core::Vector2;
+use cdpr_bench::core::channel::{Cable, Channel};
+use cdpr_bench::core::closed_loop::ClosedLoop;
+use cdpr_bench::core::model::CableModel;
+use cdpr_bench::core::runner::{RunOptions, simulate_from};
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::core::trajectory::Step5;
+use cdpr_bench::elastic::Elastic;
+use cdpr_bench::lumped::Lumped;
+use cdpr_bench::lumped::Params;
+use cdpr_bench::lumped::chain::Chain;
+use cdpr_bench::numerics::{Dopri5Options, OdeSystem};
+use cdpr_bench::numerics::{differences, eigen};
+use cdpr_bench::{ModelConfig, analyse, linearise};
 use proptest::prelude::*;
 
 fn scenario(kind: ModelKind) -> Scenario {
     let mut s = Scenario::paper();
-    s.model.kind = kind;
+    s.model = kind.into();
     s
 }
 
@@ -70,7 +75,7 @@ proptest! {
         s.controller.tension_sum = tension_sum;
         s.robot.effector_mass = mass;
         prop_assume!(mass * s.robot.gravity < 0.5 * tension_sum);
-        let a = modes::analyse(&s, x, Loop::Open).unwrap();
+        let a = analyse(&s, x, Loop::Open).unwrap();
         let model = Elastic::new(&s);
         let (wx, wz, w3) = elastic_closed_form(&model, Vector2::new(a.x, a.z), a.tensions);
         let vertical = a.vertical().unwrap().mode;
@@ -90,12 +95,12 @@ proptest! {
 #[test]
 fn elastic_vertical_mode_at_the_symmetric_position() {
     let s = scenario(ModelKind::Elastic);
-    let open = modes::analyse(&s, 0.5, Loop::Open).unwrap();
+    let open = analyse(&s, 0.5, Loop::Open).unwrap();
     let model = Elastic::new(&s);
     let w3 = model.vertical_frequency(Vector2::new(open.x, open.z), open.tensions);
     let w = open.vertical().unwrap().mode.omega;
     assert!((w - w3).abs() < 1e-6 * w3, "{w} vs {w3}");
-    let closed = modes::analyse(&s, 0.6, Loop::Closed).unwrap();
+    let closed = analyse(&s, 0.6, Loop::Closed).unwrap();
     let wc = closed.vertical().unwrap().mode.omega;
     let w3 = model.vertical_frequency(Vector2::new(closed.x, closed.z), closed.tensions);
     eprintln!("x = 0.6: closed-loop vertical {wc:.4} rad/s, §3 geometric {w3:.4} rad/s");
@@ -154,8 +159,8 @@ proptest! {
         let reach: Vec<f64> = (0..2 * n)
             .map(|i| if i < n { 0.25 * (a - chain.segment) } else { f64::INFINITY })
             .collect();
-        let jac = modal::jacobian_within(&mut sys, 0.0, &y, 2 * n, &reach, &[]);
-        let shapes = modal::mode_shapes(&jac).unwrap();
+        let jac = differences::jacobian_within(&mut sys, 0.0, &y, 2 * n, &reach, &[]);
+        let shapes = eigen::mode_shapes(&jac).unwrap();
         let (mut transverse, mut axial) = (Vec::new(), Vec::new());
         for s in &shapes {
             let share = |axis: usize| -> f64 {
@@ -191,7 +196,7 @@ fn first_string_modes_near_the_taut_string() {
         let s = scenario(kind);
         for x in [0.5, 0.6] {
             for feedback in [Loop::Closed, Loop::Open] {
-                let a = modes::analyse(&s, x, feedback).unwrap();
+                let a = analyse(&s, x, feedback).unwrap();
                 let mut exact: Vec<f64> = (0..2)
                     .map(|cable| {
                         let chord = Vector2::new(cable as f64, 0.0) - Vector2::new(a.x, a.z);
@@ -234,9 +239,13 @@ fn first_string_modes_near_the_taut_string() {
 #[test]
 fn fine_lumped_mesh_keeps_the_axial_mode_converged() {
     let growing = |elements: i64| {
-        let mut s = scenario(ModelKind::Lumped);
-        s.model.elements = Some(elements);
-        let a = modes::analyse(&s, 0.5, Loop::Closed).unwrap();
+        let mut s = Scenario::paper();
+        s.model = ModelConfig {
+            elements: Some(elements),
+            ..ModelConfig::of_kind(ModelKind::Lumped)
+        }
+        .into();
+        let a = analyse(&s, 0.5, Loop::Closed).unwrap();
         let fast: Vec<_> = a
             .modes
             .iter()
@@ -267,7 +276,7 @@ fn damped_string_modes_do_not_grow() {
         for c in [7.5e-3, 3.16e-2, 0.1, 0.316, 1.0] {
             let mut s = scenario(kind);
             s.cable.axial_damping = c;
-            let a = modes::analyse(&s, 0.6, Loop::Closed).unwrap();
+            let a = analyse(&s, 0.6, Loop::Closed).unwrap();
             let sigma: Vec<f64> = a
                 .modes
                 .iter()
@@ -294,7 +303,7 @@ fn damped_string_modes_do_not_grow() {
 /// (20.329 lumped, 20.325 FE ±0.005 rad/s closed loop).
 #[test]
 fn growing_modes_are_the_documented_ones() {
-    let lumped = modes::analyse(&scenario(ModelKind::Lumped), 0.6, Loop::Closed).unwrap();
+    let lumped = analyse(&scenario(ModelKind::Lumped), 0.6, Loop::Closed).unwrap();
     let growing: Vec<_> = lumped
         .modes
         .iter()
@@ -309,7 +318,7 @@ fn growing_modes_are_the_documented_ones() {
     );
     assert!((lumped.vertical().unwrap().mode.omega - 20.329).abs() < 0.005);
 
-    let fe = modes::analyse(&scenario(ModelKind::Fe), 0.6, Loop::Closed).unwrap();
+    let fe = analyse(&scenario(ModelKind::Fe), 0.6, Loop::Closed).unwrap();
     let mut growing: Vec<_> = fe.modes.iter().filter(|m| m.mode.growth > 0.01).collect();
     growing.sort_by(|a, b| a.mode.omega.total_cmp(&b.mode.omega));
     assert_eq!(growing.len(), 2, "{growing:?}");
@@ -320,7 +329,7 @@ fn growing_modes_are_the_documented_ones() {
     }
     assert!((fe.vertical().unwrap().mode.omega - 20.325).abs() < 0.005);
 
-    let elastic = modes::analyse(&scenario(ModelKind::Elastic), 0.6, Loop::Closed).unwrap();
+    let elastic = analyse(&scenario(ModelKind::Elastic), 0.6, Loop::Closed).unwrap();
     assert!(elastic.modes.iter().all(|m| m.mode.growth < 0.0));
 }
 
@@ -338,7 +347,7 @@ fn growing_modes_are_the_documented_ones() {
 #[test]
 fn lumped_axial_growth_matches_a_nonlinear_run() {
     let s = scenario(ModelKind::Lumped);
-    let lin = modes::linearise(&s, 0.6, Loop::Closed).unwrap();
+    let lin = linearise(&s, 0.6, Loop::Closed).unwrap();
     let (k, mode) = lin
         .analysis
         .modes
@@ -350,7 +359,7 @@ fn lumped_axial_growth_matches_a_nonlinear_run() {
         panic!("least stable mode is not axial: {mode:?}")
     };
     let v = &lin.vectors[k];
-    let mut model = Lumped::new(&s).unwrap();
+    let mut model = Lumped::new(&s, Params::default()).unwrap();
     let eq = model.equilibrium(0.6, s.controller.tension_sum).unwrap();
     let np = model.positions_len();
     let scale = 2e-9 / v[..np].iter().fold(0.0f64, |a, c| a.max(c.0.abs()));
@@ -375,10 +384,10 @@ fn lumped_axial_growth_matches_a_nonlinear_run() {
     );
     let run = simulate_from(&mut sys, y0, eq, &opts, &mut |_| {}).unwrap();
     assert!(run.events.is_empty(), "no node passed a pulley");
-    let t = run.series.column("t").unwrap();
+    let t = run.series.column(Channel::Time).unwrap();
     let tension = run
         .series
-        .column(&format!("T_pulley_{}", cable + 1))
+        .column(Channel::TPulley(Cable::BOTH[cable]))
         .unwrap();
     let mean = tension.iter().sum::<f64>() / tension.len() as f64;
     let window = 0.05;
@@ -428,14 +437,14 @@ fn lumped_axial_growth_matches_a_nonlinear_run() {
 /// along the real part of the mode's eigenvector (effector amplitude 1e-6 m), whose x(t) must
 /// follow the linear solution Re(v_x e^{λt}) within 2 % of the amplitude over 2.5 s (the step
 /// rule's fourth-order stencil is what makes this hold: second-order differences turned this
-/// mode into a ±1.29 1/s real pair, see `cdpr_core::modal::jacobian`). DP45 at rtol 1e-9 so that
+/// mode into a ±1.29 1/s real pair, see `cdpr_bench::numerics::differences::jacobian`). DP45 at rtol 1e-9 so that
 /// its error (≤ rtol·|x| ≈ 5e-10 m) stays far below the 1e-6 m signal. Measured: 3e-11 m.
 #[test]
 fn lumped_open_loop_drift_is_an_oscillation() {
     let s = scenario(ModelKind::Lumped);
-    let fe = modes::analyse(&scenario(ModelKind::Fe), 0.5, Loop::Open).unwrap();
+    let fe = analyse(&scenario(ModelKind::Fe), 0.5, Loop::Open).unwrap();
     let fe_drift = fe.find(ModeKind::Horizontal, 1).unwrap().mode;
-    let lin = modes::linearise(&s, 0.5, Loop::Open).unwrap();
+    let lin = linearise(&s, 0.5, Loop::Open).unwrap();
     let (k, m) = lin
         .analysis
         .modes
@@ -448,7 +457,7 @@ fn lumped_open_loop_drift_is_an_oscillation() {
     assert!((m.mode.omega / fe_drift.omega - 1.0).abs() < 0.01);
 
     let v = &lin.vectors[k];
-    let mut model = Lumped::new(&s).unwrap();
+    let mut model = Lumped::new(&s, Params::default()).unwrap();
     let eq = model.equilibrium(0.5, s.controller.tension_sum).unwrap();
     let px = model.xi(0, model.elements);
     let scale = 1e-6 / v[px].0.hypot(v[px].1);
@@ -459,7 +468,8 @@ fn lumped_open_loop_drift_is_an_oscillation() {
     let x_eq = lin.state[px];
     let tensions = lin.analysis.tensions;
     let mut sys = ClosedLoop::new(model, &s);
-    sys.actuation = cdpr_core::closed_loop::Actuation::Prescribed(Box::new(move |_| tensions));
+    sys.actuation =
+        cdpr_bench::core::closed_loop::Actuation::Prescribed(Box::new(move |_| tensions));
     let opts = RunOptions::dopri5(
         2.5,
         1e-2,
@@ -474,10 +484,10 @@ fn lumped_open_loop_drift_is_an_oscillation() {
     let mut worst: f64 = 0.0;
     for (t, x) in run
         .series
-        .column("t")
+        .column(Channel::Time)
         .unwrap()
         .iter()
-        .zip(run.series.column("x").unwrap())
+        .zip(run.series.column(Channel::X).unwrap())
     {
         let linear =
             scale * (sigma * t).exp() * (v[px].0 * (omega * t).cos() - v[px].1 * (omega * t).sin());

@@ -2,22 +2,24 @@
 //! each model and across them, MODELS.md §7's closed-loop vertical modes, and the massive-cable
 //! models agreeing with each other within the discretisation error we measure.
 
-use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{ModelKind, Scenario};
-use cdpr_lumped::Lumped;
-use cdpr_verify::{Assessed, acceptance, assess, eq15_at_end};
+use cdpr_bench::ModelKind;
+use cdpr_bench::core::model::CableModel;
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::lumped::Lumped;
+use cdpr_bench::lumped::Params;
+use cdpr_bench::{Assessed, assess, eq15_at_end};
+use cdpr_verify::acceptance;
 
 fn paper(kind: ModelKind) -> Scenario {
     let mut s = Scenario::paper();
-    s.model.kind = kind;
+    s.model = kind.into();
     s
 }
 
 /// Lumped effector z at the static equilibrium at x2 with `n` elements per cable [m].
-fn lumped_z_at_end(n: i64) -> f64 {
-    let mut s = paper(ModelKind::Lumped);
-    s.model.elements = Some(n);
-    let mut m = Lumped::new(&s).unwrap();
+fn lumped_z_at_end(n: usize) -> f64 {
+    let s = Scenario::paper();
+    let mut m = Lumped::new(&s, Params { elements: n }).unwrap();
     let eq = m
         .equilibrium(s.trajectory.x2, s.controller.tension_sum)
         .unwrap();
@@ -35,7 +37,10 @@ fn paper_scenario_meets_every_section_8_row_with_every_model() {
         handles.into_iter().map(|h| h.join().unwrap()).collect()
     });
     let [elastic, lumped, fe] = [&runs[0], &runs[1], &runs[2]];
-    let results: Vec<_> = runs.iter().map(Assessed::result).collect();
+    let results: Vec<_> = runs
+        .iter()
+        .map(|r| acceptance::result(r, &paper(r.kind)))
+        .collect();
     let rows = acceptance::table(eq15_at_end(&Scenario::paper()), &results);
     let failed: Vec<_> = rows.iter().filter(|c| !c.pass).collect();
     assert!(failed.is_empty(), "failed §8 rows: {failed:#?}");

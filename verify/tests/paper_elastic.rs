@@ -1,16 +1,20 @@
 //! The paper's scenario with the elastic model meets every row of MODELS.md §8, and the runs are
 //! bit-reproducible and fail cleanly.
 
-use cdpr_core::closed_loop::RunError;
-use cdpr_core::scenario::Scenario;
+use cdpr_bench::core::runner::RunError;
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::lumped::{Lumped, Params};
+use cdpr_bench::{Error, ModelConfig, ModelKind, assess, end_state, eq15_at_end, simulate};
 use cdpr_verify::acceptance;
-use cdpr_verify::{SimulateError, assess, eq15_at_end, simulate, vertical_mode_at_end};
 
 #[test]
 fn paper_scenario_meets_every_section_8_row() {
     let scenario = Scenario::paper();
     let elastic = assess(&scenario, &mut |_| {}).unwrap();
-    let rows = acceptance::table(eq15_at_end(&scenario), &[elastic.result()]);
+    let rows = acceptance::table(
+        eq15_at_end(&scenario),
+        &[acceptance::result(&elastic, &scenario)],
+    );
     let failed: Vec<_> = rows.iter().filter(|c| !c.pass).collect();
     assert!(failed.is_empty(), "failed §8 rows: {failed:#?}");
     assert!(
@@ -30,7 +34,7 @@ fn initial_state_and_closed_loop_mode_match_models_md() {
     let run = simulate(&scenario, &mut |_| {}).unwrap();
     let z0 = run.series.row(0)[3];
     assert!((z0 + 0.0245546).abs() < 1e-7, "z0 = {z0}");
-    let mode = vertical_mode_at_end(&scenario).unwrap();
+    let mode = end_state(&scenario).unwrap().mode;
     assert!((mode.omega - 20.3738).abs() < 5e-4, "{mode:?}");
     // The PID damps it, only just: the controller acts horizontally.
     assert!(mode.growth < 0.0 && mode.damping_ratio() < 1e-3, "{mode:?}");
@@ -61,7 +65,7 @@ fn slack_cable_stops_the_run_with_time_and_cable() {
     let mut scenario = Scenario::paper();
     scenario.trajectory.t2 = 0.02;
     let err = simulate(&scenario, &mut |_| {}).unwrap_err();
-    let SimulateError::Run(failure) = err else {
+    let Error::Run(failure) = err else {
         panic!("expected a run failure, got {err:?}");
     };
     let RunError::SlackCable { t, cable, tension } = failure.error else {
@@ -87,15 +91,24 @@ fn slack_cable_stops_the_run_with_time_and_cable() {
     );
 }
 
-/// A model parameter outside the model's domain is a clear error naming the key (here a lumped
-/// cable of 2 elements: no reel end, straddling spring and free node at once; the scenario file's
-/// own check already refuses it, so the scenario is built in code to reach the model's check).
+/// A model parameter outside the model's domain is a clear error naming the key, before any work
+/// starts (here a lumped cable of 2 elements: no reel end, straddling spring and free node at
+/// once), from the scenario file, from a scenario built in code, and from the model's own
+/// constructor.
 #[test]
 fn unsupported_model_parameters_answer_with_a_clear_error() {
+    let text = "[model]\nkind = \"lumped\"\nelements = 2\n[cable]\nmodelled_length = 3.0";
+    let err = cdpr_bench::scenario_from_toml_str(text).unwrap_err();
+    assert!(err.to_string().contains("model.elements"), "{err}");
     let mut scenario = Scenario::paper();
-    scenario.model.kind = cdpr_core::scenario::ModelKind::Lumped;
-    scenario.model.elements = Some(2);
+    scenario.model = ModelConfig {
+        elements: Some(2),
+        ..ModelConfig::of_kind(ModelKind::Lumped)
+    }
+    .into();
     let err = simulate(&scenario, &mut |_| {}).unwrap_err();
-    assert!(matches!(err, SimulateError::Model(_)), "{err:?}");
+    assert!(matches!(err, Error::Scenario(_)), "{err:?}");
+    assert!(err.to_string().contains("model.elements"), "{err}");
+    let err = Lumped::new(&scenario, Params { elements: 2 }).unwrap_err();
     assert!(err.to_string().contains("model.elements"), "{err}");
 }

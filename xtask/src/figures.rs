@@ -10,10 +10,12 @@
 
 use crate::output::write_atomic;
 use anyhow::{Context, Result, anyhow};
-use cdpr_core::closed_loop::Run;
-use cdpr_core::metrics::{PAD, SETTLED_FROM};
-use cdpr_core::spectrum::{Spectrum, Window};
-use cdpr_core::trajectory::Step5;
+use cdpr_bench::ModelKind;
+use cdpr_bench::analysis::metrics::{PAD, SETTLED_FROM};
+use cdpr_bench::analysis::spectrum::{Spectrum, Window};
+use cdpr_bench::core::channel::Channel;
+use cdpr_bench::core::runner::Run;
+use cdpr_bench::core::trajectory::Step5;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
@@ -64,11 +66,11 @@ pub struct Curve<'a> {
 }
 
 /// The colour of each model in every figure.
-pub fn model_color(name: &str) -> RGBColor {
-    match name {
-        "elastic" => RGBColor(31, 119, 180),
-        "lumped" => RGBColor(214, 39, 40),
-        _ => RGBColor(44, 160, 44),
+pub fn model_color(kind: ModelKind) -> RGBColor {
+    match kind {
+        ModelKind::Elastic => RGBColor(31, 119, 180),
+        ModelKind::Lumped => RGBColor(214, 39, 40),
+        ModelKind::Fe => RGBColor(44, 160, 44),
     }
 }
 
@@ -110,10 +112,10 @@ pub fn envelope(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     out
 }
 
-/// Channel `name` of `run` against time, over [t0, t1] s, scaled by `scale`, thinned.
-pub fn channel(run: &Run, name: &str, t0: f64, t1: f64, scale: f64) -> Vec<(f64, f64)> {
+/// `channel` of `run` against time, over [t0, t1] s, scaled by `scale`, thinned.
+pub fn channel(run: &Run, channel: Channel, t0: f64, t1: f64, scale: f64) -> Vec<(f64, f64)> {
     let s = &run.series;
-    let (Some(it), Some(iv)) = (s.index("t"), s.index(name)) else {
+    let (Some(it), Some(iv)) = (s.index(Channel::Time), s.index(channel)) else {
         return Vec::new();
     };
     let points: Vec<(f64, f64)> = (0..s.len())
@@ -124,10 +126,10 @@ pub fn channel(run: &Run, name: &str, t0: f64, t1: f64, scale: f64) -> Vec<(f64,
     envelope(&points)
 }
 
-/// The refined amplitude spectrum (Hann, 16× padding) of channel `name` over [1 s, t_final),
+/// The refined amplitude spectrum (Hann, 16× padding) of `channel` over [1 s, t_final),
 /// as (ω, amplitude) with the maximum kept per logarithmic bucket between `w0` and `w1` rad/s.
-pub fn spectrum(run: &Run, name: &str, dt: f64, w0: f64, w1: f64) -> Vec<(f64, f64)> {
-    let (Some(t), Some(v)) = (run.series.column("t"), run.series.column(name)) else {
+pub fn spectrum(run: &Run, channel: Channel, dt: f64, w0: f64, w1: f64) -> Vec<(f64, f64)> {
+    let (Some(t), Some(v)) = (run.series.column(Channel::Time), run.series.column(channel)) else {
         return Vec::new();
     };
     let t_end = t.last().copied().unwrap_or(0.0);

@@ -16,6 +16,7 @@ mod simulate;
 mod statics_sweep;
 mod work_precision;
 
+use cdpr_bench::ModelKind;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -37,9 +38,9 @@ enum Command {
         /// Scenario file (TOML, MODELS.md §9); absent = the paper's scenario.
         #[arg(long)]
         scenario: Option<PathBuf>,
-        /// Cable model, overriding the scenario's [model] kind: elastic | lumped | fe.
-        #[arg(long)]
-        model: Option<String>,
+        /// Cable model, overriding the scenario's [model] kind.
+        #[arg(long, value_enum)]
+        model: Option<ModelKind>,
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
@@ -83,9 +84,9 @@ enum Command {
         /// Scenario file (TOML, MODELS.md §9); absent = the paper's scenario.
         #[arg(long)]
         scenario: Option<PathBuf>,
-        /// Cable model, overriding the scenario's [model] kind: elastic | lumped | fe.
-        #[arg(long)]
-        model: Option<String>,
+        /// Cable model, overriding the scenario's [model] kind.
+        #[arg(long, value_enum)]
+        model: Option<ModelKind>,
         /// Effector x range [m] and its number of points.
         #[arg(long, default_value_t = 0.15)]
         x_min: f64,
@@ -111,7 +112,7 @@ fn main() -> ExitCode {
             model,
             out,
             every,
-        } => simulate::run(scenario.as_deref(), model.as_deref(), &out, every),
+        } => simulate::run(scenario.as_deref(), model, &out, every),
         Command::Report { out, scenario } => report::run(scenario.as_deref(), &out),
         Command::WorkPrecision { out } => work_precision::run_study(&out),
         Command::Modes { scenario, at, out } => modes::run(scenario.as_deref(), at, &out),
@@ -126,7 +127,7 @@ fn main() -> ExitCode {
             tension_steps,
         } => statics_sweep::run(
             scenario.as_deref(),
-            model.as_deref(),
+            model,
             statics_sweep::Axis {
                 min: x_min,
                 max: x_max,

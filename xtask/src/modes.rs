@@ -7,15 +7,17 @@
 use crate::figures::{Drawing, model_color, power_label, render_drawing};
 use crate::output::write_atomic;
 use anyhow::{Context, Result, anyhow};
-use cdpr_core::Vector2;
-use cdpr_core::scenario::{ModelKind, Scenario};
-use cdpr_verify::modes::{self, Analysis, ClassifiedMode, Loop, ModeKind, Sweep};
+use cdpr_bench::ModelKind;
+use cdpr_bench::analysis::damping::Sweep;
+use cdpr_bench::analysis::modes::{self, Analysis, ClassifiedMode, Loop, ModeKind};
+use cdpr_bench::core::Vector2;
+use cdpr_bench::core::scenario::Scenario;
 use plotters::prelude::*;
 use std::io::Write;
 use std::path::Path;
 
 /// Growth rate [1/s] at or below which a mode counts as decaying in the damping sweep
-/// (justification at [`modes::damping_sweep`]).
+/// (justification at [`cdpr_bench::analysis::damping::damping_sweep`]).
 pub const SWEEP_THRESHOLD: f64 = 1e-2;
 /// Damping range of the sweep [N s] and its scan points (log-spaced, then bisection).
 const SWEEP_RANGE: (f64, f64) = (1e-5, 1.0);
@@ -35,15 +37,13 @@ pub struct ModesReport {
 
 /// The three models' closed- and open-loop modes at each x, and the damping sweep at `sweep_at`.
 pub fn compute(base: &Scenario, xs: &[f64], sweep_at: f64) -> Result<ModesReport> {
-    let kinds = [ModelKind::Elastic, ModelKind::Lumped, ModelKind::Fe];
     let mut analyses = Vec::new();
     for &x in xs {
-        for kind in kinds {
-            let mut s = base.clone();
-            s.model.kind = kind;
+        for kind in ModelKind::ALL {
+            let s = cdpr_bench::with_model_kind(base, kind)?;
             for feedback in [Loop::Closed, Loop::Open] {
                 analyses.push(
-                    modes::analyse(&s, x, feedback)
+                    cdpr_bench::analyse(&s, x, feedback)
                         .map_err(|e| anyhow!("{kind} model at x = {x}: {e}"))?,
                 );
             }
@@ -52,9 +52,8 @@ pub fn compute(base: &Scenario, xs: &[f64], sweep_at: f64) -> Result<ModesReport
     let sweeps = [ModelKind::Lumped, ModelKind::Fe]
         .into_iter()
         .map(|kind| {
-            let mut s = base.clone();
-            s.model.kind = kind;
-            modes::damping_sweep(&s, sweep_at, SWEEP_RANGE, SWEEP_SCAN, SWEEP_THRESHOLD)
+            let s = cdpr_bench::with_model_kind(base, kind)?;
+            cdpr_bench::damping_sweep(&s, sweep_at, SWEEP_RANGE, SWEEP_SCAN, SWEEP_THRESHOLD)
                 .map_err(|e| anyhow!("{kind} damping sweep: {e}"))
         })
         .collect::<Result<Vec<_>>>()?;
@@ -234,7 +233,7 @@ impl ModesReport {
         )?;
         writeln!(w, "|---|---|---|---|---|---|---|---|---|")?;
         for a in &self.analyses {
-            let eq15 = cdpr_elastic::eq15_frequency(
+            let eq15 = cdpr_bench::elastic::eq15_frequency(
                 0.5 * (a.tensions[0] + a.tensions[1]),
                 self.effector_mass,
                 a.x,
@@ -422,7 +421,8 @@ where
         ))
         .map_err(err)?;
     for a in analyses {
-        let color = model_color(a.model);
+        let kind: ModelKind = a.model.parse()?;
+        let color = model_color(kind);
         let points: Vec<(f64, f64)> = a
             .modes
             .iter()

@@ -2,7 +2,7 @@
 //! sees half a file and an interrupted run never leaves one; and the progress bar.
 
 use anyhow::{Context, Result};
-use cdpr_core::series::TimeSeries;
+use cdpr_bench::core::series::TimeSeries;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::{BufWriter, IsTerminal, Write};
 use std::path::Path;

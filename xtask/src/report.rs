@@ -8,12 +8,14 @@ use crate::figures::{self, Curve, Figure, Line, Marker, Panel};
 use crate::output::{write_atomic, write_json};
 use crate::simulate::load_scenario;
 use anyhow::{Result, bail};
-use cdpr_core::closed_loop::Run;
-use cdpr_core::metrics::Metrics;
-use cdpr_core::modal::Mode;
-use cdpr_core::scenario::{ModelKind, Scenario};
-use cdpr_core::trajectory::Step5;
-use cdpr_verify::Assessed as Outcome;
+use cdpr_bench::Assessed as Outcome;
+use cdpr_bench::ModelKind;
+use cdpr_bench::analysis::metrics::Metrics;
+use cdpr_bench::core::channel::Channel;
+use cdpr_bench::core::runner::Run;
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::core::trajectory::Step5;
+use cdpr_bench::numerics::eigen::Mode;
 use cdpr_verify::acceptance::{self, Check, ModelResult};
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
@@ -66,9 +68,9 @@ fn bars(kinds: &[ModelKind]) -> (MultiProgress, Vec<ProgressBar>) {
 }
 
 /// Runs and measures one model of the scenario.
-fn run_model(scenario: &Scenario, bar: &ProgressBar) -> Result<Outcome> {
-    let outcome = cdpr_verify::assess(scenario, &mut |f| bar.set_position((f * 1000.0) as u64))
-        .map_err(|e| anyhow::anyhow!("{} model: {e}", scenario.model.kind))?;
+fn run_model(scenario: &Scenario, kind: ModelKind, bar: &ProgressBar) -> Result<Outcome> {
+    let outcome = cdpr_bench::assess(scenario, &mut |f| bar.set_position((f * 1000.0) as u64))
+        .map_err(|e| anyhow::anyhow!("{kind} model: {e}"))?;
     bar.finish();
     Ok(outcome)
 }
@@ -76,7 +78,7 @@ fn run_model(scenario: &Scenario, bar: &ProgressBar) -> Result<Outcome> {
 pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     let base = load_scenario(scenario, None)?;
     std::fs::create_dir_all(out)?;
-    let kinds = [ModelKind::Elastic, ModelKind::Lumped, ModelKind::Fe];
+    let kinds = ModelKind::ALL;
     let (_multi, bars) = bars(&kinds);
     // One thread per model: the machine's cores run them side by side; results keep model order.
     let results: Vec<Result<Outcome>> = std::thread::scope(|scope| {
@@ -84,9 +86,11 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
             .iter()
             .zip(&bars)
             .map(|(&kind, bar)| {
-                let mut s = base.clone();
-                s.model.kind = kind;
-                scope.spawn(move || run_model(&s, bar))
+                let base = &base;
+                scope.spawn(move || {
+                    let s = cdpr_bench::with_model_kind(base, kind)?;
+                    run_model(&s, kind, bar)
+                })
             })
             .collect();
         handles
@@ -99,8 +103,12 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     });
     let outcomes = results.into_iter().collect::<Result<Vec<Outcome>>>()?;
 
-    let eq15 = cdpr_verify::eq15_at_end(&base);
-    let views: Vec<ModelResult> = outcomes.iter().map(Outcome::result).collect();
+    let eq15 = cdpr_bench::eq15_at_end(&base);
+    let axial_mode = cdpr_bench::mode_as_integrated(&base, acceptance::LUMPED_AXIAL_MODE);
+    let views: Vec<ModelResult> = outcomes
+        .iter()
+        .map(|o| ModelResult::of(o, axial_mode))
+        .collect();
     let checks = acceptance::table(eq15, &views);
 
     let names = write_figures(&base, &outcomes, eq15, out)?;
@@ -141,7 +149,7 @@ fn curves(outcomes: &[Outcome]) -> Vec<Curve<'_>> {
         .iter()
         .map(|o| Curve {
             label: o.kind.name(),
-            color: figures::model_color(o.kind.name()),
+            color: figures::model_color(o.kind),
             run: &o.run,
         })
         .collect()
@@ -179,13 +187,13 @@ fn write_figures(
         lines,
         markers,
     };
-    let mut x_lines = lines(&c, |r| figures::channel(r, "x", 0.0, t_end, 1.0));
+    let mut x_lines = lines(&c, |r| figures::channel(r, Channel::X, 0.0, t_end, 1.0));
     if let Some(first) = outcomes.first() {
         x_lines.push(Line {
             label: "x_ref (step5)".into(),
             color: black,
             dashed: true,
-            points: figures::channel(&first.run, "x_ref", 0.0, t_end, 1.0),
+            points: figures::channel(&first.run, Channel::XRef, 0.0, t_end, 1.0),
         });
     }
     let mut figures_out = vec![
@@ -197,7 +205,7 @@ fn write_figures(
                 panel(
                     "t [s]",
                     "z [mm]",
-                    lines(&c, |r| figures::channel(r, "z", 0.0, t_end, 1e3)),
+                    lines(&c, |r| figures::channel(r, Channel::Z, 0.0, t_end, 1e3)),
                     vec![],
                     false,
                 ),
@@ -210,14 +218,14 @@ fn write_figures(
                 panel(
                     "t [s]",
                     "error [mm]",
-                    lines(&c, |r| figures::channel(r, "error", 0.0, t_end, 1e3)),
+                    lines(&c, |r| figures::channel(r, Channel::Error, 0.0, t_end, 1e3)),
                     vec![],
                     false,
                 ),
                 panel(
                     "t [s]",
                     "|error| [m]",
-                    lines(&c, |r| figures::channel(r, "error", 0.0, t_end, 1.0)),
+                    lines(&c, |r| figures::channel(r, Channel::Error, 0.0, t_end, 1.0)),
                     vec![
                         Marker::Horizontal(1e-5, "1e-5 m (paper: after 1 s)".into()),
                         Marker::Vertical(1.0, "t = 1 s".into()),
@@ -227,29 +235,29 @@ fn write_figures(
             ],
         },
     ];
-    let spectrum_panel = |name: &str, label: &str| Panel {
+    let spectrum_panel = |channel: Channel, label: &str| Panel {
         x_label: "ω [rad/s]".into(),
         y_label: label.into(),
         log_x: true,
         log_y: true,
-        lines: lines(&c, |r| figures::spectrum(r, name, dt, 1.0, 2.0e5)),
+        lines: lines(&c, |r| figures::spectrum(r, channel, dt, 1.0, 2.0e5)),
         markers: vec![Marker::Vertical(eq15, format!("eq. 15: {eq15:.2} rad/s"))],
     };
     figures_out.push(Figure {
         name: "fig7_spectrum".into(),
         title: "Fig. 7: amplitude spectra over [1, 5] s (Hann window, 16× zero padding)".into(),
         panels: vec![
-            spectrum_panel("error", "|error| amplitude [m]"),
-            spectrum_panel("z", "|z| amplitude [m]"),
+            spectrum_panel(Channel::Error, "|error| amplitude [m]"),
+            spectrum_panel(Channel::Z, "|z| amplitude [m]"),
         ],
     });
     let t2 = base.trajectory.t2;
     let tensions = |t0: f64, t1: f64| {
-        let mut v = lines(&c, |r| figures::channel(r, "T1", t0, t1, 1.0));
+        let mut v = lines(&c, |r| figures::channel(r, Channel::T1, t0, t1, 1.0));
         for (line, curve) in v.iter_mut().zip(&c) {
             line.label = format!("T1 {}", curve.label);
         }
-        let mut t2_lines = lines(&c, |r| figures::channel(r, "T2", t0, t1, 1.0));
+        let mut t2_lines = lines(&c, |r| figures::channel(r, Channel::T2, t0, t1, 1.0));
         for (line, curve) in t2_lines.iter_mut().zip(&c) {
             line.label = format!("T2 {}", curve.label);
             line.dashed = true;

@@ -2,9 +2,9 @@
 
 use crate::output::{progress_bar, write_csv, write_json};
 use anyhow::{Context, Result, bail};
-use cdpr_core::metrics::Metrics;
-use cdpr_core::scenario::{ModelKind, Scenario};
-use cdpr_verify::SimulateError;
+use cdpr_bench::analysis::metrics::Metrics;
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::{Error, ModelConfig, ModelKind};
 use std::path::Path;
 
 /// `metrics.json`: the §7 metrics at the top level plus the frequencies they are judged against.
@@ -20,28 +20,38 @@ pub struct MetricsFile<'a> {
     pub eq15_rad_s: f64,
 }
 
-/// Loads the scenario file (or the paper's) and applies a `--model` override.
-pub fn load_scenario(path: Option<&Path>, model: Option<&str>) -> Result<Scenario> {
-    let mut scenario = match path {
-        Some(p) => Scenario::from_file(p)?,
+/// Loads the scenario file (or the paper's) and applies a `--model` override; the whole scenario
+/// is checked before any work starts.
+pub fn load_scenario(path: Option<&Path>, model: Option<ModelKind>) -> Result<Scenario> {
+    let scenario = match path {
+        Some(p) => cdpr_bench::scenario_from_file(p)?,
         None => Scenario::paper(),
     };
-    if let Some(m) = model {
-        scenario.model.kind = m.parse::<ModelKind>().map_err(anyhow::Error::msg)?;
-        scenario.validate()?;
-    }
-    Ok(scenario)
+    Ok(match model {
+        Some(kind) => cdpr_bench::with_model_kind(&scenario, kind)?,
+        None => scenario,
+    })
 }
 
-pub fn run(scenario: Option<&Path>, model: Option<&str>, out: &Path, every: usize) -> Result<()> {
+/// The scenario's model kind (its `[model]` section was checked when it was loaded).
+pub fn model_kind(scenario: &Scenario) -> Result<ModelKind> {
+    Ok(ModelConfig::from_scenario(scenario)?.kind)
+}
+
+pub fn run(
+    scenario: Option<&Path>,
+    model: Option<ModelKind>,
+    out: &Path,
+    every: usize,
+) -> Result<()> {
     let scenario = load_scenario(scenario, model)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let bar = progress_bar(scenario.model.kind.name());
-    let result = cdpr_verify::assess(&scenario, &mut |f| bar.set_position((f * 1000.0) as u64));
+    let bar = progress_bar(model_kind(&scenario)?.name());
+    let result = cdpr_bench::assess(&scenario, &mut |f| bar.set_position((f * 1000.0) as u64));
     bar.finish_and_clear();
     let assessed = match result {
         Ok(assessed) => assessed,
-        Err(SimulateError::Run(failure)) => {
+        Err(Error::Run(failure)) => {
             if let Some(partial) = &failure.partial {
                 write_csv(&out.join("timeseries.csv"), &partial.series, every)?;
             }
@@ -60,7 +70,7 @@ pub fn run(scenario: Option<&Path>, model: Option<&str>, out: &Path, every: usiz
             metrics,
             vertical_mode_rad_s: mode.omega,
             vertical_mode_growth: mode.growth,
-            eq15_rad_s: cdpr_verify::eq15_at_end(&scenario),
+            eq15_rad_s: cdpr_bench::eq15_at_end(&scenario),
         },
     )?;
     println!(

@@ -4,9 +4,10 @@
 //! 500 000 starts on the default grid, the property test's ranges), and a way to re-check it.
 
 use crate::output::progress_bar;
-use crate::simulate::load_scenario;
+use crate::simulate::{load_scenario, model_kind};
 use anyhow::{Result, bail};
-use cdpr_core::scenario::Scenario;
+use cdpr_bench::ModelKind;
+use cdpr_bench::core::scenario::Scenario;
 use std::path::Path;
 
 /// An interval [min, max] sampled at the midpoints of `steps` equal cells.
@@ -61,7 +62,7 @@ pub fn sweep(
         for j in 0..tension_sum.steps {
             let (at, sum) = (x.at(i), tension_sum.at(j));
             // A fresh model per start: the lumped model's stored/free split is part of its state.
-            let mut model = cdpr_verify::model(scenario)?;
+            let mut model = cdpr_bench::build(scenario)?;
             if let Err(e) = model.equilibrium(at, sum) {
                 failures.push(Failure {
                     x: at,
@@ -75,11 +76,16 @@ pub fn sweep(
     Ok((failures, x.steps * tension_sum.steps))
 }
 
-pub fn run(scenario: Option<&Path>, model: Option<&str>, x: Axis, tension_sum: Axis) -> Result<()> {
+pub fn run(
+    scenario: Option<&Path>,
+    model: Option<ModelKind>,
+    x: Axis,
+    tension_sum: Axis,
+) -> Result<()> {
     let scenario = load_scenario(scenario, model)?;
     x.check("x", 0.0, scenario.robot.anchor_distance)?;
     tension_sum.check("tension", 0.0, f64::INFINITY)?;
-    let kind = scenario.model.kind.name();
+    let kind = model_kind(&scenario)?.name();
     let bar = progress_bar(kind);
     let (failures, starts) = sweep(&scenario, x, tension_sum, &mut |f| {
         bar.set_position((f * 1000.0) as u64)

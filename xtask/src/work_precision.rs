@@ -13,8 +13,10 @@
 use crate::figures::{self, Figure, Line, Panel};
 use crate::output::write_atomic;
 use anyhow::{Context, Result};
-use cdpr_core::closed_loop::Run;
-use cdpr_core::scenario::{IntegratorKind, ModelKind, Scenario};
+use cdpr_bench::ModelKind;
+use cdpr_bench::core::channel::Channel;
+use cdpr_bench::core::runner::Run;
+use cdpr_bench::core::scenario::{IntegratorKind, Scenario};
 use std::path::Path;
 
 /// Simulated horizon [s] and sample period [s] of the study.
@@ -42,7 +44,7 @@ struct Point {
 
 fn scenario(model: ModelKind, integrator: IntegratorKind, parameter: f64) -> Result<Scenario> {
     let mut s = Scenario::paper();
-    s.model.kind = model;
+    s.model = model.into();
     s.simulation.t_final = HORIZON;
     s.simulation.sample_period = SAMPLE_PERIOD;
     s.simulation.integrator = integrator;
@@ -53,14 +55,14 @@ fn scenario(model: ModelKind, integrator: IntegratorKind, parameter: f64) -> Res
         }
         IntegratorKind::Implicit => s.simulation.step = parameter,
     }
-    s.validate()?;
+    cdpr_bench::validate(&s)?;
     Ok(s)
 }
 
 /// The run, the faster of two (identical: runs are deterministic) for the wall time.
 fn run(s: &Scenario) -> Result<Run> {
-    let first = cdpr_verify::simulate(s, &mut |_| {})?;
-    let second = cdpr_verify::simulate(s, &mut |_| {})?;
+    let first = cdpr_bench::simulate(s, &mut |_| {})?;
+    let second = cdpr_bench::simulate(s, &mut |_| {})?;
     Ok(if second.wall_s < first.wall_s {
         second
     } else {
@@ -69,9 +71,9 @@ fn run(s: &Scenario) -> Result<Run> {
 }
 
 fn error(run: &Run, reference: &Run) -> Result<f64> {
-    let col = |r: &Run, c: &str| r.series.column(c).context("missing channel");
-    let (x, z) = (col(run, "x")?, col(run, "z")?);
-    let (xr, zr) = (col(reference, "x")?, col(reference, "z")?);
+    let col = |r: &Run, c: Channel| r.series.column(c).context("missing channel");
+    let (x, z) = (col(run, Channel::X)?, col(run, Channel::Z)?);
+    let (xr, zr) = (col(reference, Channel::X)?, col(reference, Channel::Z)?);
     Ok((0..x.len().min(xr.len()))
         .map(|i| (x[i] - xr[i]).hypot(z[i] - zr[i]))
         .fold(0.0, f64::max))
@@ -84,7 +86,7 @@ pub fn run_study(out: &Path) -> Result<()> {
         eprintln!("{model}: reference (DOPRI5, rtol {REFERENCE_RTOL:e})");
         let mut reference_scenario = scenario(model, IntegratorKind::Dopri5, REFERENCE_RTOL)?;
         reference_scenario.simulation.atol = 1e-14;
-        let reference = cdpr_verify::simulate(&reference_scenario, &mut |_| {})?;
+        let reference = cdpr_bench::simulate(&reference_scenario, &mut |_| {})?;
         let sweeps = RTOLS
             .iter()
             .map(|&p| (IntegratorKind::Dopri5, p))
@@ -155,7 +157,7 @@ pub fn run_study(out: &Path) -> Result<()> {
                                 }
                             }
                         ),
-                        color: figures::model_color(model.name()),
+                        color: figures::model_color(model),
                         dashed: integrator == IntegratorKind::Implicit,
                         points: points
                             .iter()

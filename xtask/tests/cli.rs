@@ -95,7 +95,10 @@ fn bad_scenario_is_reported_with_key_and_range() {
 #[test]
 fn unknown_models_are_clear_errors() {
     let dir = TempDir::new("model");
-    for (model, expect) in [("rigid", "unknown model `rigid`"), ("", "unknown model ``")] {
+    for (model, expect) in [
+        ("rigid", "invalid value 'rigid' for '--model <MODEL>'"),
+        ("", "a value is required for '--model <MODEL>'"),
+    ] {
         let output = xtask()
             .args(["simulate", "--model", model, "--out"])
             .arg(dir.join("out"))
@@ -104,6 +107,10 @@ fn unknown_models_are_clear_errors() {
         assert!(!output.status.success());
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(stderr.contains(expect), "{model}: {stderr}");
+        assert!(
+            stderr.contains("possible values: elastic, lumped, fe"),
+            "{model}: {stderr}"
+        );
     }
 }
 

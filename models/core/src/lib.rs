@@ -1,23 +1,23 @@
 //! # cdpr-core
 //!
-//! Everything the cable models of cdpr-bench share, and nothing about any one cable: the scenario
-//! (MODELS.md §9), the `step5` trajectory (paper eq. 13), the PID and tension distribution (§3.2),
-//! the [`model::CableModel`] interface, the closed loop and its runner, the integrators, the static
-//! Newton service, spectra, metrics and the closed-loop linearisation.
+//! The robot of cdpr-bench, and nothing about any one cable model: the scenario (MODELS.md §9),
+//! the `step5` trajectory (paper eq. 13), the PID and tension distribution (§3.2), the
+//! [`model::CableModel`] interface (with its second-order form and what the modal analysis needs
+//! from a model), the closed loop and the runner that integrates and samples it.
 //!
-//! Dependencies point one way: models depend on this crate; this crate knows no model.
+//! Dependencies point one way: the numerical methods come from `cdpr-numerics`; the models
+//! depend on this crate; this crate knows no model.
 
+pub mod channel;
 pub mod closed_loop;
 pub mod controller;
 pub mod geometry;
-pub mod integrate;
-pub mod metrics;
-pub mod modal;
+pub mod modal_layout;
 pub mod model;
+pub mod runner;
 pub mod scenario;
 pub mod second_order;
 pub mod series;
-pub mod spectrum;
 pub mod statics;
 pub mod trajectory;
 

@@ -5,6 +5,8 @@
 //! extra output channels it has. It knows nothing of the controller, the trajectory or the
 //! integrator; the closed loop ([`crate::closed_loop`]) knows nothing of cables.
 
+use crate::modal_layout::ModalLayout;
+use crate::scenario::{Scenario, ScenarioError};
 use crate::second_order::SecondOrderForm;
 use nalgebra::Vector2;
 
@@ -20,25 +22,11 @@ pub enum ModelError {
     },
     /// The static equilibrium of MODELS.md §2 was not found.
     #[error("static equilibrium not found: {0}")]
-    Equilibrium(#[from] crate::statics::NewtonError),
+    Equilibrium(#[from] cdpr_numerics::newton::NewtonError),
     /// The state left the model's domain (e.g. a node ordering the pulley rule forbids).
     #[error("invalid model state at t = {t} s: {why}")]
     State { t: f64, why: String },
 }
-
-/// The channels every massive-cable model provides, named alike so that the report and the
-/// cross-model tests compare them: tension at the effector end and next to the pulley [N], free
-/// unstrained length [m], and the stored amount (lumped: nodes; FE: length ρ_i [m]), per cable.
-pub const CABLE_CHANNELS: [&str; 8] = [
-    "T_effector_1",
-    "T_effector_2",
-    "T_pulley_1",
-    "T_pulley_2",
-    "l_free_1",
-    "l_free_2",
-    "stored_1",
-    "stored_2",
-];
 
 /// MODELS.md §2 holds the effector's x fixed for the static equilibrium: it must lie strictly
 /// between the pulleys A1 = (0, 0) and A2 = (d, 0).
@@ -179,6 +167,20 @@ pub trait CableModel {
     fn second_order_mut(&mut self) -> Option<&mut dyn SecondOrderForm> {
         None
     }
+
+    /// The coordinate groups and constrained coordinates at `state`, for the modal analysis.
+    fn modal_layout(&self, state: &[f64]) -> ModalLayout;
+}
+
+/// A model's own parameters (its keys of the scenario's `[model]` section): what checks a
+/// scenario against the model's needs and builds the model from it.
+pub trait ModelParams {
+    type Model: CableModel + Clone + Send + 'static;
+    /// The model's own checks of the scenario (e.g. enough modelled cable for the trajectory),
+    /// before any work starts.
+    fn validate(&self, scenario: &Scenario) -> Result<(), ScenarioError>;
+    /// The model for the scenario's robot and cable.
+    fn build(&self, scenario: &Scenario) -> Result<Self::Model, ModelError>;
 }
 
 /// A boxed model is a model: one dispatcher can hand any model to the closed loop
@@ -238,5 +240,8 @@ impl<M: CableModel + ?Sized> CableModel for Box<M> {
     }
     fn second_order_mut(&mut self) -> Option<&mut dyn SecondOrderForm> {
         (**self).second_order_mut()
+    }
+    fn modal_layout(&self, state: &[f64]) -> ModalLayout {
+        (**self).modal_layout(state)
     }
 }

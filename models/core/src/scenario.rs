@@ -29,7 +29,7 @@ pub enum ScenarioError {
     },
 }
 
-fn out_of_range(
+pub fn out_of_range(
     key: &'static str,
     value: impl fmt::Display,
     allowed: impl Into<String>,
@@ -102,89 +102,12 @@ impl Cable {
     }
 }
 
-/// Which cable model a run uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum ModelKind {
-    /// Massless elastic springs (paper §2.1).
-    #[default]
-    Elastic,
-    /// Lumped mass-spring cable sliding over the pulley (paper §2.2).
-    Lumped,
-    /// Variable-length finite elements (paper §2.3).
-    Fe,
-}
-
-impl ModelKind {
-    pub fn name(self) -> &'static str {
-        match self {
-            ModelKind::Elastic => "elastic",
-            ModelKind::Lumped => "lumped",
-            ModelKind::Fe => "fe",
-        }
-    }
-}
-
-impl fmt::Display for ModelKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for ModelKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "elastic" => Ok(ModelKind::Elastic),
-            "lumped" => Ok(ModelKind::Lumped),
-            "fe" => Ok(ModelKind::Fe),
-            other => Err(format!(
-                "unknown model `{other}`: allowed elastic, lumped, fe"
-            )),
-        }
-    }
-}
-
-/// FE mass matrix variant (MODELS.md FE.1.5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum FeMass {
-    #[default]
-    Consistent,
-    Lumped,
-}
-
-/// FE stored-cable variant (MODELS.md FE.1.3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum FeStored {
-    #[default]
-    Elastic,
-    Rigid,
-}
-
-/// Model selection and discretisation.
-#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
-#[serde(default, deny_unknown_fields)]
-pub struct Model {
-    pub kind: ModelKind,
-    /// Elements per cable; absent = 40 (lumped) / 10 (FE); unused by the elastic model.
-    pub elements: Option<i64>,
-    pub fe_mass: FeMass,
-    pub fe_stored: FeStored,
-}
-
-impl Model {
-    /// Elements per cable after applying the per-model default (paper: 40 lumped, 10 FE).
-    pub fn elements(&self) -> usize {
-        match (self.elements, self.kind) {
-            (Some(n), _) => n as usize,
-            (None, ModelKind::Lumped) => 40,
-            (None, ModelKind::Fe) => 10,
-            (None, ModelKind::Elastic) => 0,
-        }
-    }
-}
+/// The `[model]` section as written: the cable model's `kind` and its own keys. The core knows no
+/// cable model: each model crate owns its keys' defaults and validation, and the registry crate
+/// (`cdpr-bench`) reads this section into its typed model choice.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize, serde::Serialize)]
+#[serde(transparent)]
+pub struct ModelSection(pub toml::Table);
 
 /// PID gains and tension distribution (MODELS.md §2).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -329,7 +252,7 @@ impl Default for Simulation {
 pub struct Scenario {
     pub robot: Robot,
     pub cable: Cable,
-    pub model: Model,
+    pub model: ModelSection,
     pub controller: Controller,
     pub trajectory: Trajectory,
     pub simulation: Simulation,
@@ -374,16 +297,6 @@ impl Scenario {
         positive("cable.density", c.density)?;
         positive("cable.modelled_length", c.modelled_length)?;
         non_negative("cable.axial_damping", c.axial_damping)?;
-
-        if let Some(n) = self.model.elements
-            && !(1..=100_000).contains(&n)
-        {
-            return Err(out_of_range(
-                "model.elements",
-                n,
-                "an integer in [1, 100000]",
-            ));
-        }
 
         let k = &self.controller;
         non_negative("controller.p", k.p)?;
@@ -487,19 +400,16 @@ impl Scenario {
             return Err(out_of_range("simulation.rho_inf", s.rho_inf, "[0, 1]"));
         }
 
-        self.validate_modelled_length()
+        Ok(())
     }
 
-    /// MODELS.md §9: the massive-cable models need enough modelled cable for the whole trajectory.
-    fn validate_modelled_length(&self) -> Result<(), ScenarioError> {
-        let kind = self.model.kind;
-        if kind == ModelKind::Elastic {
-            return Ok(());
-        }
+    /// The free cable length the trajectory needs, for the massive-cable models' rule on
+    /// `cable.modelled_length` (MODELS.md §9): 1.05 × (1 + ΣT/EA) × the longest chord from a
+    /// pulley to the trajectory, the chord's depth bounded by the elastic model's mid-span sag.
+    /// Returns (free length [m], longest chord [m]).
+    pub fn free_length_needed(&self) -> (f64, f64) {
         let r = &self.robot;
-        let c = &self.cable;
         let t = &self.trajectory;
-        // Elastic-model sag at mid-span bounds the effector's depth well enough for a 5 % margin.
         let sag = 0.5
             * r.anchor_distance
             * (r.effector_mass * r.gravity / self.controller.tension_sum)
@@ -507,28 +417,32 @@ impl Scenario {
                 .tan();
         let reach = t.x1.max(t.x2).max(r.anchor_distance - t.x1.min(t.x2));
         let chord = reach.hypot(sag);
-        let stretch = 1.0 + self.controller.tension_sum / c.axial_stiffness();
-        let free = 1.05 * stretch * chord;
-        let l0 = c.modelled_length;
-        let n = self.model.elements().max(1) as f64;
-        let (needed, why) = match kind {
-            ModelKind::Lumped => (free + 2.0 * l0 / n, "two spare stored elements"),
-            _ => (free / 0.95, "a stored length ≥ 5 % of it"),
-        };
-        if l0 < needed {
-            return Err(out_of_range(
-                "cable.modelled_length",
-                l0,
-                format!(
-                    "≥ {needed:.6} m for this trajectory (1.05 × (1 + ΣT/EA) × longest chord {chord:.6} m, plus {why})"
-                ),
-            ));
-        }
-        Ok(())
+        let stretch = 1.0 + self.controller.tension_sum / self.cable.axial_stiffness();
+        (1.05 * stretch * chord, chord)
     }
 }
 
-fn finite(key: &'static str, v: f64) -> Result<(), ScenarioError> {
+/// Largest element count a model accepts (`model.elements`; memory and run time grow like N).
+pub const MAX_ELEMENTS: usize = 100_000;
+
+/// An element count `key` = `value` in [1, [`MAX_ELEMENTS`]], or `default` when absent.
+pub fn count_in_range(
+    key: &'static str,
+    value: Option<i64>,
+    default: usize,
+) -> Result<usize, ScenarioError> {
+    match value {
+        None => Ok(default),
+        Some(n) if (1..=MAX_ELEMENTS as i64).contains(&n) => Ok(n as usize),
+        Some(n) => Err(out_of_range(
+            key,
+            n,
+            format!("an integer in [1, {MAX_ELEMENTS}]"),
+        )),
+    }
+}
+
+pub fn finite(key: &'static str, v: f64) -> Result<(), ScenarioError> {
     if v.is_finite() {
         Ok(())
     } else {
@@ -536,7 +450,7 @@ fn finite(key: &'static str, v: f64) -> Result<(), ScenarioError> {
     }
 }
 
-fn positive(key: &'static str, v: f64) -> Result<(), ScenarioError> {
+pub fn positive(key: &'static str, v: f64) -> Result<(), ScenarioError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
@@ -544,7 +458,7 @@ fn positive(key: &'static str, v: f64) -> Result<(), ScenarioError> {
     }
 }
 
-fn non_negative(key: &'static str, v: f64) -> Result<(), ScenarioError> {
+pub fn non_negative(key: &'static str, v: f64) -> Result<(), ScenarioError> {
     if v.is_finite() && v >= 0.0 {
         Ok(())
     } else {
@@ -561,14 +475,6 @@ mod tests {
         let s = Scenario::from_toml_str("").unwrap();
         assert_eq!(s, Scenario::paper());
         assert_eq!(s.cable.axial_stiffness(), 102e9 * 1.76e-6);
-        assert_eq!(s.model.kind.name(), "elastic");
-    }
-
-    #[test]
-    fn element_defaults_follow_the_model() {
-        let s = Scenario::from_toml_str("[model]\nkind = \"lumped\"").unwrap();
-        assert_eq!(s.model.elements(), 40);
-        let s = Scenario::from_toml_str("[model]\nkind = \"fe\"").unwrap();
-        assert_eq!(s.model.elements(), 10);
+        assert!(s.model.0.is_empty());
     }
 }

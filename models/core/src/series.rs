@@ -1,6 +1,8 @@
 //! Sampled output channels of a run, stored row by row (one contiguous buffer, appended once per
 //! sample) and read by column for analysis.
 
+use crate::channel::Channel;
+
 /// Named channels sampled on a common time grid; channel 0 is the time t [s].
 #[derive(Debug, Clone, PartialEq)]
 pub struct TimeSeries {
@@ -64,14 +66,25 @@ impl TimeSeries {
         &self.data[i * w..(i + 1) * w]
     }
 
-    /// Index of the channel called `name`.
-    pub fn index(&self, name: &str) -> Option<usize> {
+    /// Index of `channel`, if the run has it.
+    pub fn index(&self, channel: Channel) -> Option<usize> {
+        self.index_named(channel.name())
+    }
+
+    /// Index of the channel called `name` (a model's own channel).
+    pub fn index_named(&self, name: &str) -> Option<usize> {
         self.names.iter().position(|n| n == name)
     }
 
-    /// A copy of the channel called `name`, if there is one.
-    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
-        let j = self.index(name)?;
+    /// A copy of `channel`, if the run has it (every run has [`Channel::COMMON`] and
+    /// [`Channel::ENERGY`]; the massive-cable models also [`Channel::CABLE`]).
+    pub fn column(&self, channel: Channel) -> Option<Vec<f64>> {
+        self.column_named(channel.name())
+    }
+
+    /// A copy of the channel called `name` (a model's own channel), if there is one.
+    pub fn column_named(&self, name: &str) -> Option<Vec<f64>> {
+        let j = self.index_named(name)?;
         Some(
             self.data
                 .iter()

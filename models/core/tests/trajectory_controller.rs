@@ -4,9 +4,9 @@
 //! PID integrated as an ODE, and the two identities of Pott's distribution.
 
 use cdpr_core::controller::{Pid, PidState, TensionDistribution};
-use cdpr_core::integrate::{Dopri5, Dopri5Options, OdeSystem};
 use cdpr_core::scenario;
 use cdpr_core::trajectory::Step5;
+use cdpr_numerics::{Dopri5, Dopri5Options, OdeSystem};
 use proptest::prelude::*;
 
 fn config(cases: u32) -> ProptestConfig {

@@ -6,9 +6,10 @@
 //!
 //! State: (x, z, ẋ, ż) of the effector [m, m/s].
 
-use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError};
-use cdpr_core::scenario::Scenario;
-use cdpr_core::statics::{self, NewtonOptions, StaticProblem};
+use cdpr_core::modal_layout::{Dof, ModalLayout};
+use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError, ModelParams};
+use cdpr_core::scenario::{Scenario, ScenarioError};
+use cdpr_numerics::newton::{self, NewtonOptions, StaticProblem};
 use nalgebra::Vector2;
 
 /// The two-cable robot with massless elastic cables.
@@ -29,6 +30,20 @@ const X: usize = 0;
 const Z: usize = 1;
 const VX: usize = 2;
 const VZ: usize = 3;
+
+/// The elastic model has no keys of its own in the `[model]` section, and stores no cable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Params;
+
+impl ModelParams for Params {
+    type Model = Elastic;
+    fn validate(&self, _scenario: &Scenario) -> Result<(), ScenarioError> {
+        Ok(())
+    }
+    fn build(&self, scenario: &Scenario) -> Result<Elastic, ModelError> {
+        Ok(Elastic::new(scenario))
+    }
+}
 
 impl Elastic {
     /// The model with the scenario's robot and cable.
@@ -134,6 +149,18 @@ impl CableModel for Elastic {
         "elastic"
     }
 
+    /// One group: the effector, which is all the model's coordinates.
+    fn modal_layout(&self, _state: &[f64]) -> ModalLayout {
+        ModalLayout {
+            dofs: vec![Dof::Effector {
+                x: X,
+                z: Z,
+                mass: self.effector_mass,
+            }],
+            frozen: Vec::new(),
+        }
+    }
+
     fn state_len(&self) -> usize {
         4
     }
@@ -162,7 +189,7 @@ impl CableModel for Elastic {
             x: effector_x,
             tension_sum,
         };
-        let report = statics::solve(&mut problem, &mut unknowns, NewtonOptions::default())?;
+        let report = newton::solve(&mut problem, &mut unknowns, NewtonOptions::default())?;
         Ok(Equilibrium {
             state: vec![effector_x, unknowns[0], 0.0, 0.0],
             force: unknowns[1],

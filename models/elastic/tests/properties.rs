@@ -1,11 +1,13 @@
 //! Property tests of the elastic model against references it did not produce: the force balance
 //! written out independently, eq. 15 in the small-sag limit, and the first integral of MODELS.md §3.
 
-use cdpr_core::closed_loop::{Actuation, ClosedLoop, RunOptions, simulate_from};
-use cdpr_core::integrate::Dopri5Options;
+use cdpr_core::channel::Channel;
+use cdpr_core::closed_loop::{Actuation, ClosedLoop};
 use cdpr_core::model::CableModel;
+use cdpr_core::runner::{RunOptions, simulate_from};
 use cdpr_core::scenario::Scenario;
 use cdpr_elastic::{Elastic, eq15_frequency};
+use cdpr_numerics::Dopri5Options;
 use nalgebra::Vector2;
 use proptest::prelude::*;
 
@@ -97,8 +99,15 @@ proptest! {
         let opts = RunOptions::dopri5(1.0, 1e-3, Dopri5Options { rtol: 1e-10, atol: 1e-12, ..Dopri5Options::default() });
         let run = simulate_from(&mut sys, y0, eq, &opts, &mut |_| {}).unwrap();
         let s = &run.series;
-        let col = |n: &str| s.column(n).unwrap();
-        let (ek, eg, l1, l2, resid) = (col("e_kinetic"), col("e_gravity"), col("l1"), col("l2"), col("e_residual"));
+        let col = |c: Channel| s.column(c).unwrap();
+        let own = |name: &str| s.column_named(name).unwrap();
+        let (ek, eg, l1, l2, resid) = (
+            col(Channel::EKinetic),
+            col(Channel::EGravity),
+            own("l1"),
+            own("l2"),
+            col(Channel::EResidual),
+        );
         let energy: Vec<f64> = (0..s.len())
             .map(|i| ek[i] + eg[i] + tensions[0] * l1[i] + tensions[1] * l2[i])
             .collect();

@@ -4,9 +4,9 @@
 //! lumped gravity μ g h/2 on each end node.
 
 use crate::element::{self, ElementState, MassCoefficients, Material};
+use crate::params::FeMass;
 use cdpr_core::model::ModelError;
-use cdpr_core::scenario::FeMass;
-use cdpr_core::statics::{self, NewtonOptions, StaticProblem};
+use cdpr_numerics::newton::{self, NewtonOptions, StaticProblem};
 use nalgebra::Vector2;
 
 /// An FE cable of N elements between fixed ends A and B.
@@ -107,7 +107,7 @@ impl FixedCable {
                 ea: self.material.ea * factor,
                 ..self.material
             };
-            statics::solve(
+            newton::solve(
                 &mut Statics {
                     cable: self,
                     material,
@@ -117,7 +117,7 @@ impl FixedCable {
                 opts,
             )?;
         }
-        statics::solve(
+        newton::solve(
             &mut Statics {
                 cable: self,
                 material: self.material,

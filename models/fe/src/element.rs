@@ -5,10 +5,13 @@
 //! from the span's physics.
 //!
 //! Kinematics (FE.3): v(η) = (1 − η) a + η b + l' w(η) Δ/h, Δ = r_b − r_a, w linear in η. The
-//! kinetic energy is T_e = ½ μ h (c1|a|² + 2c2 a·b + c1|b|²) + μ l'(α a + β b)·Δ + ½ μ γ l'²|Δ|²/h
-//! (FE.4), with the coefficients of [`MassCoefficients`].
+//! kinetic energy is the paper's eq. 8 integrated exactly over the element, T_e = ½ μ h (c1|a|² +
+//! 2c2 a·b + c1|b|²) + μ l'(α a + β b)·Δ + ½ μ γ l'²|Δ|²/h (FE.4), with the coefficients of
+//! [`MassCoefficients`]; the potential is eq. 9's (strain energy and weight). Lagrange's equations
+//! of the two (eq. 11, with the mass-flux work of eq. 10 contained in the ansatz, FE.5.2) give the
+//! element's rows of eq. 12, m q'' + c q' + k q = f + f_g, as M_e and F_e (FE.5.3).
 
-use cdpr_core::scenario::FeMass;
+use crate::params::FeMass;
 use nalgebra::Vector2;
 
 /// Element mass coefficients c1, c2, α, β, γ of MODELS.md FE.4 for weights (w_a, w_b).

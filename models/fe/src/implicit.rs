@@ -11,13 +11,14 @@
 //! 5 local unknowns and adding the 5 × 5 blocks gives the exact
 //! global pattern of FE.5.5 (block-tridiagonal with the border rows and columns) at O(N) cost.
 //! Central differences with δ = ε^(1/3)·max(|u|, 1e-2) are accurate to ~1e-10 relative (as in
-//! [`cdpr_core::second_order::ColouredDifferences`]), the position steps kept within a quarter
-//! of the element's stretch ([`cdpr_core::second_order::central_step`]); the derivative in q''
+//! [`cdpr_numerics::differences::ColouredDifferences`]), the position steps kept within a quarter
+//! of the element's stretch ([`cdpr_numerics::differences::central_step`]); the derivative in q''
 //! is linear and exact.
 
 use crate::element::{self, Chord, ElementState};
 use crate::{E_OUT, Fe};
-use cdpr_core::second_order::{MatrixCost, SecondOrderForm, central_step, spring_round_off};
+use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
+use cdpr_numerics::differences::central_step;
 use nalgebra::Vector2;
 
 /// One additive block of R: an element, the rigid stored cable or the effector.
@@ -86,7 +87,7 @@ impl Fe {
     }
 
     /// Largest finite-difference step over which the block's forces are smooth in its positions
-    /// (see [`cdpr_core::second_order::ColouredDifferences`]): a quarter of the element's
+    /// (see [`cdpr_numerics::differences::ColouredDifferences`]): a quarter of the element's
     /// |stretch| = ||Δ| − h|, so no probe reaches the tension-only kink (at N = 1000 the stretch
     /// is 2.8–4.5e-7 m, below the 6e-6 m a step scaled by the coordinate would take). A change δ of l
     /// moves h by δ/N (δ for the stored element), so the same limit is safe for l.

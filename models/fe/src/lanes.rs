@@ -199,7 +199,7 @@ impl ChainRows {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cdpr_core::scenario::FeMass;
+    use crate::params::FeMass;
     use proptest::prelude::*;
 
     proptest! {

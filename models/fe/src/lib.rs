@@ -7,8 +7,10 @@
 //! through the nodes at the convective speed l_i'(1 − ξ_k) (FE.3). The stored cable is one more
 //! element of the same kind ([`element`]), of unstrained length L0 − l_i, whose reel end R_i sits at
 //! distance ρ_i from the pulley; the commanded tension T_i pulls R_i away from the pulley (Q_ρ = T_i).
-//! Nothing is prescribed kinematically: Lagrange's equations of the ansatz contain every mass-flux
-//! term, so dE/dt = T_1 ρ_1' + T_2 ρ_2' exactly (FE.7) and the runner's `e_residual` audits it.
+//! Nothing is prescribed kinematically: Lagrange's equations (paper eq. 11) of the kinetic and
+//! potential energies (eq. 8, 9) contain every mass-flux term of eq. 10, so dE/dt = T_1 ρ_1' +
+//! T_2 ρ_2' exactly (FE.7) and the runner's `e_residual` audits it; each element contributes its
+//! rows of eq. 12 ([`element`]).
 //!
 //! Generalised coordinates (FE.5.1) in the chain order of FE.5.5, as structure-of-arrays:
 //! `q = [x of the 2N − 1 chain nodes | z of the chain nodes | l1, ρ1, l2, ρ2]` with the chain
@@ -24,13 +26,16 @@ pub mod chain;
 pub mod element;
 mod implicit;
 mod lanes;
+mod modal;
+pub mod params;
 pub mod solve;
 mod statics;
 
 use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError};
-use cdpr_core::scenario::{FeMass, FeStored, Scenario};
+use cdpr_core::scenario::Scenario;
 use element::{Chord, ElementState, MassCoefficients, Material};
 use nalgebra::Vector2;
+pub use params::{FeMass, FeStored, Params};
 use solve::ChainSystem;
 
 /// Direction from each pulley towards its reel, e_out,i (MODELS.md FE.2).
@@ -105,8 +110,8 @@ pub struct Fe {
 
 impl Fe {
     /// The model with the scenario's robot, cable, element count and variants.
-    pub fn new(scenario: &Scenario) -> Result<Self, ModelError> {
-        let n = scenario.model.elements();
+    pub fn new(scenario: &Scenario, params: Params) -> Result<Self, ModelError> {
+        let n = params.elements;
         if n < 1 {
             return Err(ModelError::Parameter {
                 name: "model.elements",
@@ -122,8 +127,7 @@ impl Fe {
                 allowed: "finite and ≥ 0 N s (Kelvin–Voigt, MODELS.md FE.5.7)".into(),
             });
         }
-        let mass = scenario.model.fe_mass;
-        let stored = scenario.model.fe_stored;
+        let Params { mass, stored, .. } = params;
         let coefficients = (1..=n)
             .map(|e| {
                 let w = |k: usize| 1.0 - k as f64 / n as f64;
@@ -575,7 +579,9 @@ impl CableModel for Fe {
     }
 
     fn channel_names(&self) -> Vec<String> {
-        cdpr_core::model::CABLE_CHANNELS.map(String::from).to_vec()
+        cdpr_core::channel::Channel::CABLE
+            .map(|c| c.name().to_owned())
+            .to_vec()
     }
 
     fn second_order(&self) -> Option<&dyn cdpr_core::second_order::SecondOrderForm> {
@@ -584,6 +590,10 @@ impl CableModel for Fe {
 
     fn second_order_mut(&mut self) -> Option<&mut dyn cdpr_core::second_order::SecondOrderForm> {
         Some(self)
+    }
+
+    fn modal_layout(&self, state: &[f64]) -> cdpr_core::modal_layout::ModalLayout {
+        self.modal_layout_of(state)
     }
 
     /// Element tensions N_N (at the effector) and N_1 (at the pulley) [N], free unstrained lengths
@@ -628,17 +638,18 @@ mod tests {
             (4, FeStored::Rigid),
             (10, FeStored::Elastic),
         ] {
-            let mut s = Scenario::paper();
-            s.model.kind = cdpr_core::scenario::ModelKind::Fe;
-            s.model.elements = Some(elements);
-            s.model.fe_stored = stored;
-            let fe = Fe::new(&s).unwrap();
+            let params = Params {
+                elements,
+                stored,
+                ..Params::default()
+            };
+            let fe = Fe::new(&Scenario::paper(), params).unwrap();
             let y: Vec<f64> = (0..2 * fe.positions_len())
                 .map(|i| 0.3 + 0.1 * (i as f64 * 0.77).sin())
                 .collect();
             for cable in 0..2 {
                 let walked: Vec<_> = fe.span(&y, cable).collect();
-                assert_eq!(walked.len(), elements as usize);
+                assert_eq!(walked.len(), elements);
                 for (e, state) in (1..).zip(&walked) {
                     assert_eq!(
                         *state,
@@ -650,7 +661,7 @@ mod tests {
             // The channels' end tensions, computed per span, are `element_tension`'s.
             let mut out = vec![0.0; fe.channel_names().len()];
             fe.channels(&y, [100.0, 100.0], &mut out);
-            let n = elements as usize;
+            let n = elements;
             let expected =
                 [(0, n), (1, n), (0, 1), (1, 1)].map(|(c, e)| fe.element_tension(&y, c, e).1);
             assert_eq!(out[..4], expected);

@@ -9,7 +9,8 @@
 use crate::Fe;
 use cdpr_core::model::{CableModel, Equilibrium, ModelError};
 use cdpr_core::second_order::SecondOrderForm;
-use cdpr_core::statics::{self, NewtonOptions, StaticProblem};
+use cdpr_core::statics;
+use cdpr_numerics::newton::{self, NewtonOptions, StaticProblem};
 use nalgebra::Vector2;
 
 struct Problem<'a> {
@@ -129,7 +130,7 @@ pub(crate) fn equilibrium(
     tension_sum: f64,
 ) -> Result<Equilibrium, ModelError> {
     let (mut problem, mut u) = problem(model, effector_x, tension_sum)?;
-    let report = statics::solve(&mut problem, &mut u, NewtonOptions::default())?;
+    let report = newton::solve(&mut problem, &mut u, NewtonOptions::default())?;
     problem.load(&u);
     let force = u[problem.map.len()];
     debug_assert_eq!(problem.y.len(), problem.model.state_len());
@@ -213,8 +214,9 @@ fn problem(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cdpr_core::scenario::{FeStored, Scenario};
-    use cdpr_core::second_order::{CBRT_EPSILON, ColouredDifferences};
+    use crate::params::{FeStored, Params};
+    use cdpr_core::scenario::Scenario;
+    use cdpr_numerics::differences::{CBRT_EPSILON, ColouredDifferences};
 
     /// The element-by-element static Jacobian against coloured central differences of the
     /// whole residual (the path it replaces), summed over duplicate entries, near the
@@ -225,10 +227,12 @@ mod tests {
     #[test]
     fn block_jacobian_matches_coloured_differences() {
         for stored in [FeStored::Elastic, FeStored::Rigid] {
-            let mut s = Scenario::paper();
-            s.model.elements = Some(4);
-            s.model.fe_stored = stored;
-            let mut model = Fe::new(&s).unwrap();
+            let params = Params {
+                elements: 4,
+                stored,
+                ..Params::default()
+            };
+            let mut model = Fe::new(&Scenario::paper(), params).unwrap();
             let (mut problem, u) = problem(&mut model, 0.6, 200.0).unwrap();
             let n = u.len();
             let pattern = problem.pattern().unwrap();

@@ -5,9 +5,10 @@
 
 mod common;
 
+use cdpr_core::channel::Channel;
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{FeMass, FeStored};
-use cdpr_fe::Fe;
+use cdpr_core::scenario::Scenario;
+use cdpr_fe::{Fe, FeMass, FeStored, Params};
 use common::*;
 
 /// Prescribed tensions (FE.10.3's) and a kick of both reel ends (ρ_i' = ∓0.5 m/s, with the free
@@ -21,9 +22,9 @@ use common::*;
 fn damped_energy_balance_holds() {
     for mass in [FeMass::Consistent, FeMass::Lumped] {
         for (rtol, atol, bound) in [(1e-5, 1e-8, 1e-6), (1e-8, 1e-11, 1e-8)] {
-            let mut scenario = scenario(10, mass, FeStored::Elastic);
+            let mut scenario = Scenario::paper();
             scenario.cable.axial_damping = 1.0;
-            let mut m = Fe::new(&scenario).unwrap();
+            let mut m = Fe::new(&scenario, params(10, mass, FeStored::Elastic)).unwrap();
             assert_eq!(m.axial_damping, 1.0);
             let eq = m.equilibrium(0.5, 200.0).unwrap();
             let np = m.positions_len();
@@ -36,7 +37,12 @@ fn damped_energy_balance_holds() {
             let d0 = m.dissipation(&y);
             assert!(d0 >= 0.0, "D = {d0} W must not be negative");
             let (run, worst) = wobbling_run(m, &scenario, eq, y, 0.3, (rtol, atol));
-            let dissipated = *run.series.column("e_dissipated").unwrap().last().unwrap();
+            let dissipated = *run
+                .series
+                .column(Channel::EDissipated)
+                .unwrap()
+                .last()
+                .unwrap();
             eprintln!(
                 "{mass:?} rtol {rtol:e}: max |E − E0 − W + D| = {worst:e} J, D = {dissipated:e} J, \
                  {} RHS",
@@ -59,9 +65,9 @@ fn damped_energy_balance_holds() {
 /// coefficient is refused with the key's name.
 #[test]
 fn damping_vanishes_at_rest_and_is_validated() {
-    let mut damped_scenario = scenario(10, FeMass::Consistent, FeStored::Elastic);
+    let mut damped_scenario = Scenario::paper();
     damped_scenario.cable.axial_damping = 3.0;
-    let mut damped = Fe::new(&damped_scenario).unwrap();
+    let mut damped = Fe::new(&damped_scenario, Params::default()).unwrap();
     let mut plain = model(10, FeMass::Consistent, FeStored::Elastic);
     let eq = plain.equilibrium(0.6, 200.0).unwrap();
     let eq_damped = damped.equilibrium(0.6, 200.0).unwrap();
@@ -74,9 +80,9 @@ fn damping_vanishes_at_rest_and_is_validated() {
     assert_eq!(a, b);
     assert_eq!(damped.dissipation(&eq.state), 0.0);
     for bad in [-1.0, f64::NAN] {
-        let mut s = scenario(10, FeMass::Consistent, FeStored::Elastic);
+        let mut s = Scenario::paper();
         s.cable.axial_damping = bad;
-        let err = Fe::new(&s).unwrap_err();
+        let err = Fe::new(&s, Params::default()).unwrap_err();
         assert!(err.to_string().contains("cable.axial_damping"), "{err}");
     }
 }

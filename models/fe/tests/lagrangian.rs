@@ -7,9 +7,9 @@ mod common;
 
 use cdpr_core::Vector2;
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{FeMass, FeStored};
+use cdpr_core::scenario::Scenario;
 use cdpr_fe::element::{self, ElementState, MassCoefficients, Material};
-use cdpr_fe::{E_OUT, Fe};
+use cdpr_fe::{E_OUT, Fe, FeMass, FeStored};
 use common::*;
 use proptest::prelude::*;
 
@@ -339,9 +339,9 @@ fn zero_pay_out_is_the_standard_truss() {
 fn steady_pay_out_is_a_steady_state() {
     let mut worst = [0.0; 2];
     for (k, stored) in [FeStored::Elastic, FeStored::Rigid].into_iter().enumerate() {
-        let mut s = scenario(10, FeMass::Consistent, stored);
+        let mut s = Scenario::paper();
         s.robot.gravity = 0.0;
-        let mut m = Fe::new(&s).unwrap();
+        let mut m = Fe::new(&s, params(10, FeMass::Consistent, stored)).unwrap();
         let eq = m.equilibrium(0.5, 200.0).unwrap();
         assert!(eq.force.abs() < 1e-9);
         let mut y = eq.state;

@@ -3,10 +3,10 @@
 //! the closed loop around it.
 
 use cdpr_core::closed_loop::ClosedLoop;
-use cdpr_core::integrate::OdeSystem;
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{ModelKind, Scenario};
-use cdpr_fe::Fe;
+use cdpr_core::scenario::Scenario;
+use cdpr_fe::{Fe, Params};
+use cdpr_numerics::OdeSystem;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -29,12 +29,11 @@ static GLOBAL: Counting = Counting;
 
 #[test]
 fn rhs_does_not_allocate() {
-    let mut scenario = Scenario::paper();
-    scenario.model.kind = ModelKind::Fe;
-    let mut model = Fe::new(&scenario).unwrap();
+    let scenario = Scenario::paper();
+    let mut model = Fe::new(&scenario, Params::default()).unwrap();
     let eq = model.equilibrium(0.5, 200.0).unwrap();
     let mut rate = vec![0.0; model.state_len()];
-    let mut sys = ClosedLoop::new(Fe::new(&scenario).unwrap(), &scenario);
+    let mut sys = ClosedLoop::new(Fe::new(&scenario, Params::default()).unwrap(), &scenario);
     let (y, _) = sys.initial_state().unwrap();
     let mut dy = vec![0.0; y.len()];
     let mut check = 0.0;

@@ -4,12 +4,14 @@
 
 mod common;
 
-use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate_from};
-use cdpr_core::integrate::Dopri5Options;
+use cdpr_core::channel::Channel;
+use cdpr_core::closed_loop::ClosedLoop;
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{FeMass, FeStored};
+use cdpr_core::runner::{RunOptions, simulate_from};
+use cdpr_core::scenario::Scenario;
 use cdpr_core::trajectory::Step5;
-use cdpr_fe::Fe;
+use cdpr_fe::{Fe, FeMass, FeStored};
+use cdpr_numerics::Dopri5Options;
 use common::*;
 
 fn paper_model() -> Fe {
@@ -40,7 +42,7 @@ fn symmetric_start_is_symmetric() {
 /// |x − 0.5| and the drift of z below 1e-12 m over 0.5 s (the bound).
 #[test]
 fn equilibrium_is_preserved() {
-    let mut scenario = scenario(10, FeMass::Consistent, FeStored::Elastic);
+    let mut scenario = Scenario::paper();
     scenario.trajectory.x2 = scenario.trajectory.x1;
     let mut sys = ClosedLoop::new(paper_model(), &scenario);
     sys.trajectory = Step5::from(&scenario.trajectory);
@@ -48,8 +50,8 @@ fn equilibrium_is_preserved() {
     let z0 = sys.model.effector(&y0).position.y;
     let opts = RunOptions::dopri5(0.5, 1e-3, Dopri5Options::default());
     let run = simulate_from(&mut sys, y0, eq, &opts, &mut |_| {}).unwrap();
-    let x = run.series.column("x").unwrap();
-    let z = run.series.column("z").unwrap();
+    let x = run.series.column(Channel::X).unwrap();
+    let z = run.series.column(Channel::Z).unwrap();
     let dx = x.iter().fold(0.0f64, |a, v| a.max((v - 0.5).abs()));
     let dz = z.iter().fold(0.0f64, |a, v| a.max((v - z0).abs()));
     eprintln!("|x − 0.5| ≤ {dx:e} m, |z − z0| ≤ {dz:e} m");
@@ -126,12 +128,12 @@ fn cdpr_statics_match_the_continuum() {
 #[test]
 fn energy_identity_with_prescribed_tensions() {
     for (rtol, atol, bound) in [(1e-5, 1e-8, 1e-7), (1e-8, 1e-11, 1e-8)] {
-        let scenario = scenario(10, FeMass::Consistent, FeStored::Elastic);
+        let scenario = Scenario::paper();
         let mut m = paper_model();
         let eq = m.equilibrium(0.5, 200.0).unwrap();
         let y = eq.state.clone();
         let (run, worst) = wobbling_run(m, &scenario, eq, y, 0.5, (rtol, atol));
-        let throughput = column_max_abs(&run, "w_reel");
+        let throughput = column_max_abs(&run, Channel::WReel);
         eprintln!(
             "rtol {rtol:e}: max |E − E0 − W| = {worst:e} J, max |W| = {throughput:.4} J, {} RHS",
             run.stats.rhs_evals

@@ -7,7 +7,7 @@
 
 use crate::spring_tension;
 use cdpr_core::model::ModelError;
-use cdpr_core::statics::{self, NewtonOptions, StaticProblem};
+use cdpr_numerics::newton::{self, NewtonOptions, StaticProblem};
 use nalgebra::Vector2;
 
 /// A lumped cable between fixed ends.
@@ -129,7 +129,7 @@ impl Chain {
                 stiffness: self.stiffness * factor,
                 ..self.clone()
             };
-            statics::solve(
+            newton::solve(
                 &mut Statics {
                     chain: &soft,
                     bilateral: true,
@@ -138,7 +138,7 @@ impl Chain {
                 opts,
             )?;
         }
-        statics::solve(
+        newton::solve(
             &mut Statics {
                 chain: self,
                 bilateral: false,

@@ -10,9 +10,8 @@
 //! The pattern does not depend on which nodes are stored, so pulley events never change it.
 
 use crate::Lumped;
-use cdpr_core::second_order::{
-    CBRT_EPSILON, ColouredDifferences, MatrixCost, SecondOrderForm, spring_round_off,
-};
+use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
+use cdpr_numerics::differences::{CBRT_EPSILON, ColouredDifferences};
 use nalgebra::Vector2;
 
 /// Buffers of the second-order form (allocated once per model).
@@ -305,8 +304,9 @@ impl Lumped {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Params;
     use cdpr_core::model::CableModel;
-    use cdpr_core::scenario::{ModelKind, Scenario};
+    use cdpr_core::scenario::Scenario;
     use proptest::prelude::*;
 
     proptest! {
@@ -327,9 +327,8 @@ mod tests {
             seed in 0u32..1000,
             h in 1e-5f64..1e-3,
         ) {
-            let mut s = Scenario::paper();
-            s.model.kind = ModelKind::Lumped;
-            let mut model = Lumped::new(&s).unwrap();
+            let s = Scenario::paper();
+            let mut model = Lumped::new(&s, Params::default()).unwrap();
             let eq = model.equilibrium(x, s.controller.tension_sum).unwrap();
             let mut state = eq.state.clone();
             let n = model.elements;

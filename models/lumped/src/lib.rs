@@ -3,8 +3,9 @@
 //! Each cable is N point masses P_0 … P_{N−1} (each m = μ l0, l0 = L0/N) joined by N tension-only
 //! springs of stiffness k0 = EA/l0; spring j joins P_j and P_{j+1}, and P_N is the effector, shared
 //! by both cables. P_0 is the reel end, pulled by the commanded tension along e_out. Nodes beyond
-//! the pulley are *stored* (rolled on the reel): they slide on z = 0. The spring that straddles the
-//! pulley measures its length along the cable path over the pulley (eq. 4). Nodes pass the pulley
+//! the pulley are *stored* (rolled on the reel): they slide on z = 0 (paper eq. 6). The spring
+//! that straddles the pulley measures its length along the cable path over the pulley (eq. 4);
+//! each spring's tension follows eq. 5 and each free node moves by eq. 7. Nodes pass the pulley
 //! as located events ([`pulley`]); no node ever changes mass, so the cable mass is conserved exactly.
 //!
 //! State: positions then velocities, each laid out as structure-of-arrays so that the spring loop
@@ -15,6 +16,8 @@
 
 pub mod chain;
 mod implicit;
+mod modal;
+pub mod params;
 mod pulley;
 mod statics;
 
@@ -22,6 +25,7 @@ use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError, Mo
 use cdpr_core::scenario::Scenario;
 use nalgebra::Vector2;
 
+pub use params::Params;
 pub use pulley::PULLEY_OFFSET;
 
 /// The two-cable robot with lumped mass-spring cables.
@@ -71,7 +75,8 @@ impl SpringForces {
     }
 }
 
-/// The lumped spring law (MODELS.md §4): T = k0 (λ − l0) + (C/l0) λ̇ while taut (λ > l0), else 0;
+/// The lumped spring law (paper eq. 5, MODELS.md §4): T = k0 (λ − l0) + (C/l0) λ̇ while taut
+/// (λ > l0), else 0;
 /// a damping part that would make the spring push is clipped, so T ≥ 0 always.
 /// `stiffness` k0 [N/m], `segment` l0 [m], `damping` C/l0 [N s/m], `length` λ [m], `rate` λ̇ [m/s].
 #[inline]
@@ -89,9 +94,9 @@ pub const E_OUT: [f64; 2] = [-1.0, 1.0];
 impl Lumped {
     /// The model with the scenario's robot, cable and element count; r_i are set by
     /// [`CableModel::equilibrium`].
-    pub fn new(scenario: &Scenario) -> Result<Self, ModelError> {
-        let n = scenario.model.elements();
-        if n < 3 {
+    pub fn new(scenario: &Scenario, params: Params) -> Result<Self, ModelError> {
+        let n = params.elements;
+        if n < params::MIN_ELEMENTS {
             return Err(ModelError::Parameter {
                 name: "model.elements",
                 value: n as f64,
@@ -221,7 +226,8 @@ impl Lumped {
     }
 
     /// Net forces on every position coordinate [N] (gravity included; stored nodes' vertical
-    /// forces are constraint-reacted and zeroed), for the commanded tensions. The springs between
+    /// forces are constraint-reacted and zeroed: paper eq. 6; free nodes and the node past the
+    /// pulley: eq. 7), for the commanded tensions. The springs between
     /// two cable nodes are computed in one vectorisable sweep; the straddling spring and the spring
     /// to the effector are then recomputed along the cable path.
     fn forces(&mut self, y: &[f64], tensions: [f64; 2], out: &mut [f64]) {
@@ -431,7 +437,9 @@ impl CableModel for Lumped {
     }
 
     fn channel_names(&self) -> Vec<String> {
-        cdpr_core::model::CABLE_CHANNELS.map(String::from).to_vec()
+        cdpr_core::channel::Channel::CABLE
+            .map(|c| c.name().to_owned())
+            .to_vec()
     }
 
     fn second_order(&self) -> Option<&dyn cdpr_core::second_order::SecondOrderForm> {
@@ -440,6 +448,10 @@ impl CableModel for Lumped {
 
     fn second_order_mut(&mut self) -> Option<&mut dyn cdpr_core::second_order::SecondOrderForm> {
         Some(self)
+    }
+
+    fn modal_layout(&self, state: &[f64]) -> cdpr_core::modal_layout::ModalLayout {
+        self.modal_layout_of(state)
     }
 
     /// Spring tensions at the effector and over the pulley [N], free unstrained lengths [m] and

@@ -17,7 +17,8 @@ use crate::pulley::beyond;
 use crate::{E_OUT, Lumped};
 use cdpr_core::model::{CableModel, Equilibrium, ModelError};
 use cdpr_core::second_order::SecondOrderForm;
-use cdpr_core::statics::{self, NewtonOptions, StaticProblem};
+use cdpr_core::statics;
+use cdpr_numerics::newton::{self, NewtonOptions, StaticProblem};
 use nalgebra::Vector2;
 
 /// The unknowns ↔ state map and the force residual for a fixed split r.
@@ -344,7 +345,7 @@ pub(crate) fn equilibrium(
         let mut problem = Problem::new(model.clone(), effector_x, tension_sum);
         let mut u: Vec<f64> = problem.map.iter().map(|&i| y[i]).collect();
         u.push(0.0);
-        let solved = statics::solve(&mut problem, &mut u, NewtonOptions::default());
+        let solved = newton::solve(&mut problem, &mut u, NewtonOptions::default());
         problem.load(&u);
         y.copy_from_slice(&problem.y);
         let report = match solved {
@@ -384,7 +385,8 @@ pub(crate) fn equilibrium(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cdpr_core::scenario::{ModelKind, Scenario};
+    use crate::Params;
+    use cdpr_core::scenario::Scenario;
 
     /// The exact static Jacobian against central differences of the residual, entry by entry
     /// and outside the pattern too, at the x = 0.6 m equilibrium (F0 ≠ 0, unequal splits) with
@@ -395,9 +397,8 @@ mod tests {
     /// fails it.
     #[test]
     fn static_jacobian_matches_central_differences() {
-        let mut s = Scenario::paper();
-        s.model.kind = ModelKind::Lumped;
-        let mut model = Lumped::new(&s).unwrap();
+        let s = Scenario::paper();
+        let mut model = Lumped::new(&s, Params::default()).unwrap();
         let eq = model.equilibrium(0.6, 200.0).unwrap();
         let mut problem = Problem::new(model, 0.6, 200.0);
         let n = problem.dimension();

@@ -3,11 +3,13 @@
 //! E − E0 − W + D − ΣΔE = 0 that the runner audits as `e_residual`, with D itself large, so that a
 //! damping force without its dissipation (or the reverse) fails.
 
-use cdpr_core::closed_loop::{Actuation, ClosedLoop, RunOptions, simulate_from};
-use cdpr_core::integrate::Dopri5Options;
+use cdpr_core::channel::Channel;
+use cdpr_core::closed_loop::{Actuation, ClosedLoop};
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{ModelKind, Scenario};
-use cdpr_lumped::Lumped;
+use cdpr_core::runner::{RunOptions, simulate_from};
+use cdpr_core::scenario::Scenario;
+use cdpr_lumped::{Lumped, Params};
+use cdpr_numerics::Dopri5Options;
 
 /// From the x = 0.5 equilibrium, the reel end of each cable is kicked (ẋ = ∓0.5 m/s, towards the
 /// reel) and the effector too (ż = 0.05 m/s), under prescribed tensions (the FE test's),
@@ -18,9 +20,8 @@ use cdpr_lumped::Lumped;
 #[test]
 fn damped_energy_balance_holds() {
     let mut s = Scenario::paper();
-    s.model.kind = ModelKind::Lumped;
     s.cable.axial_damping = 1.0;
-    let mut m = Lumped::new(&s).unwrap();
+    let mut m = Lumped::new(&s, Params::default()).unwrap();
     let eq = m.equilibrium(0.5, 200.0).unwrap();
     let np = m.positions_len();
     let mut y = eq.state.clone();
@@ -50,11 +51,16 @@ fn damped_energy_balance_holds() {
     let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
     let worst = run
         .series
-        .column("e_residual")
+        .column(Channel::EResidual)
         .unwrap()
         .iter()
         .fold(0.0f64, |a, r| a.max(r.abs()));
-    let dissipated = *run.series.column("e_dissipated").unwrap().last().unwrap();
+    let dissipated = *run
+        .series
+        .column(Channel::EDissipated)
+        .unwrap()
+        .last()
+        .unwrap();
     eprintln!(
         "max |E − E0 − W + D − ΣΔE| = {worst:e} J, D = {dissipated:e} J, {} events, {} RHS",
         run.events.len(),

@@ -2,17 +2,17 @@
 //! the paper's damped-relaxation method, the energy balance with the PID off, and the invariants
 //! of the pulley rule through events.
 
-use cdpr_core::closed_loop::{Actuation, ClosedLoop, RunOptions, simulate, simulate_from};
-use cdpr_core::integrate::{Dopri5, Dopri5Options, OdeSystem};
+use cdpr_core::channel::{Cable, Channel};
+use cdpr_core::closed_loop::{Actuation, ClosedLoop};
 use cdpr_core::model::{CableModel, Equilibrium};
-use cdpr_core::scenario::{ModelKind, Scenario};
-use cdpr_lumped::{E_OUT, Lumped};
+use cdpr_core::runner::{RunOptions, simulate, simulate_from};
+use cdpr_core::scenario::Scenario;
+use cdpr_lumped::{E_OUT, Lumped, Params};
+use cdpr_numerics::{Dopri5, Dopri5Options, OdeSystem};
 use proptest::prelude::*;
 
 fn paper() -> Scenario {
-    let mut s = Scenario::paper();
-    s.model.kind = ModelKind::Lumped;
-    s
+    Scenario::paper()
 }
 
 fn tensions(tension_sum: f64, force: f64) -> [f64; 2] {
@@ -37,7 +37,7 @@ fn side_rule_holds(m: &Lumped, y: &[f64]) -> bool {
 /// z_P = −0.0237291 m, F0 = 0.097531 N. Tolerances are half a unit of the last printed digit.
 #[test]
 fn equilibrium_matches_the_independent_solution() {
-    let mut m = Lumped::new(&paper()).unwrap();
+    let mut m = Lumped::new(&paper(), Params::default()).unwrap();
     let eq = m.equilibrium(0.5, 200.0).unwrap();
     assert_eq!(m.stored(), [20, 20]);
     let z = m.effector(&eq.state).position.y;
@@ -104,7 +104,7 @@ fn equilibrium_beside_a_pulley_obeys_the_side_rule() {
         (0.324825, 231.44),
         (0.675175, 231.44),
     ] {
-        let mut m = Lumped::new(&paper()).unwrap();
+        let mut m = Lumped::new(&paper(), Params::default()).unwrap();
         let eq = m
             .equilibrium(x, tension_sum)
             .unwrap_or_else(|e| panic!("x = {x} m, ΣT = {tension_sum} N: {e}"));
@@ -122,7 +122,7 @@ proptest! {
     /// criterion; the round-off floor is k0·ulp(x) ≈ 2e-9 N).
     #[test]
     fn equilibrium_anywhere_obeys_the_side_rule(x in 0.15f64..0.85, tension_sum in 120.0f64..400.0) {
-        let mut m = Lumped::new(&paper()).unwrap();
+        let mut m = Lumped::new(&paper(), Params::default()).unwrap();
         let eq = m.equilibrium(x, tension_sum).unwrap();
         prop_assert!(side_rule_holds(&m, &eq.state), "stored {:?}", m.stored());
         let worst = largest_force(&mut m, &eq, tension_sum);
@@ -159,7 +159,7 @@ impl OdeSystem for Relaxation {
 #[test]
 fn damped_relaxation_reaches_the_newton_equilibrium() {
     for x in [0.5, 0.6] {
-        let mut m = Lumped::new(&paper()).unwrap();
+        let mut m = Lumped::new(&paper(), Params::default()).unwrap();
         let eq = m.equilibrium(x, 200.0).unwrap();
         let mut y = eq.state.clone();
         // Disturb every free coordinate (not the effector's x) by up to 1e-5 m, deterministically.
@@ -219,7 +219,7 @@ proptest! {
         v in -1e-3f64..1e-3,
     ) {
         let scenario = paper();
-        let mut m = Lumped::new(&scenario).unwrap();
+        let mut m = Lumped::new(&scenario, Params::default()).unwrap();
         let eq = m.equilibrium(0.5, 200.0).unwrap();
         let d = if sign { delta } else { -delta };
         let t = tensions(200.0, eq.force + 2.0 * d);
@@ -236,13 +236,13 @@ proptest! {
         let opts = RunOptions::dopri5(0.4, 1e-3, Dopri5Options { rtol: 1e-9, atol: 1e-12, ..Dopri5Options::default() });
         let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
         prop_assert!(run.events.len() >= 4, "the drift moved nodes over the pulleys ({} events)", run.events.len());
-        let residual = run.series.column("e_residual").unwrap();
+        let residual = run.series.column(Channel::EResidual).unwrap();
         let worst = residual.iter().fold(0.0f64, |a, r| a.max(r.abs()));
         let events: f64 = run.events.iter().map(|e| e.energy_change).sum();
         prop_assert!(worst < 2e-9, "energy balance off by {worst:e} J");
         prop_assert!(events.abs() > 2e-8, "events carried {events:e} J");
         // The reels did work: the balance is not trivially 0 = 0.
-        let work = run.series.column("w_reel").unwrap();
+        let work = run.series.column(Channel::WReel).unwrap();
         prop_assert!(work.last().unwrap().abs() > 1e-3);
     }
 }
@@ -255,11 +255,14 @@ fn events_keep_mass_nodes_and_ordering() {
     let mut scenario = paper();
     scenario.simulation.t_final = 0.4;
     scenario.simulation.sample_period = 1e-4;
-    let mut sys = ClosedLoop::new(Lumped::new(&scenario).unwrap(), &scenario);
+    let mut sys = ClosedLoop::new(
+        Lumped::new(&scenario, Params::default()).unwrap(),
+        &scenario,
+    );
     let mass = sys.model.cable_mass();
     let len = sys.model.state_len();
     let start = {
-        let mut probe = Lumped::new(&scenario).unwrap();
+        let mut probe = Lumped::new(&scenario, Params::default()).unwrap();
         probe.equilibrium(0.5, 200.0).unwrap();
         probe.stored()
     };
@@ -289,7 +292,8 @@ fn events_keep_mass_nodes_and_ordering() {
     assert!(side_rule_holds(&sys.model, &run.final_state));
     let rows = run.series.len();
     let last = run.series.row(rows - 1);
-    let idx = |name: &str| run.series.index(name).unwrap();
-    assert_eq!(last[idx("stored_1")], stored[0] as f64);
-    assert_eq!(last[idx("stored_2")], stored[1] as f64);
+    for cable in Cable::BOTH {
+        let column = run.series.index(Channel::Stored(cable)).unwrap();
+        assert_eq!(last[column], stored[cable.index()] as f64);
+    }
 }

@@ -2,8 +2,8 @@
 //! a counting global allocator, in its own test binary, watches 1000 evaluations.
 
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{ModelKind, Scenario};
-use cdpr_lumped::Lumped;
+use cdpr_core::scenario::Scenario;
+use cdpr_lumped::{Lumped, Params};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -26,9 +26,8 @@ static GLOBAL: Counting = Counting;
 
 #[test]
 fn rhs_does_not_allocate() {
-    let mut scenario = Scenario::paper();
-    scenario.model.kind = ModelKind::Lumped;
-    let mut model = Lumped::new(&scenario).unwrap();
+    let scenario = Scenario::paper();
+    let mut model = Lumped::new(&scenario, Params::default()).unwrap();
     let eq = model.equilibrium(0.5, 200.0).unwrap();
     let mut rate = vec![0.0; model.state_len()];
     let mut energy = 0.0;

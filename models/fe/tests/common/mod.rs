@@ -7,21 +7,22 @@
 #![allow(clippy::needless_range_loop)]
 
 use cdpr_core::Vector2;
+use cdpr_core::channel::Channel;
 use cdpr_core::model::CableModel;
-use cdpr_core::scenario::{FeMass, FeStored, ModelKind, Scenario};
-use cdpr_fe::{E_OUT, Fe};
+use cdpr_core::scenario::Scenario;
+use cdpr_fe::{E_OUT, Fe, FeMass, FeStored, Params};
 
-pub fn scenario(n: usize, mass: FeMass, stored: FeStored) -> Scenario {
-    let mut s = Scenario::paper();
-    s.model.kind = ModelKind::Fe;
-    s.model.elements = Some(n as i64);
-    s.model.fe_mass = mass;
-    s.model.fe_stored = stored;
-    s
+/// The FE model's parameters: `n` elements per span and the two variants.
+pub fn params(n: usize, mass: FeMass, stored: FeStored) -> Params {
+    Params {
+        elements: n,
+        mass,
+        stored,
+    }
 }
 
 pub fn model(n: usize, mass: FeMass, stored: FeStored) -> Fe {
-    Fe::new(&scenario(n, mass, stored)).unwrap()
+    Fe::new(&Scenario::paper(), params(n, mass, stored)).unwrap()
 }
 
 pub fn tensions(tension_sum: f64, force: f64) -> [f64; 2] {
@@ -184,9 +185,10 @@ pub fn wobbling_run(
     mut y: Vec<f64>,
     t_final: f64,
     (rtol, atol): (f64, f64),
-) -> (cdpr_core::closed_loop::Run, f64) {
-    use cdpr_core::closed_loop::{ClosedLoop, RunOptions, simulate_from};
-    use cdpr_core::integrate::Dopri5Options;
+) -> (cdpr_core::runner::Run, f64) {
+    use cdpr_core::closed_loop::ClosedLoop;
+    use cdpr_core::runner::{RunOptions, simulate_from};
+    use cdpr_numerics::Dopri5Options;
     y.extend_from_slice(&[0.0; 4]);
     let mut sys = ClosedLoop::new(m, scenario);
     sys.actuation = wobbling_tensions();
@@ -198,12 +200,12 @@ pub fn wobbling_run(
     };
     let opts = RunOptions::dopri5(t_final, 1e-4, dopri);
     let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
-    let worst = column_max_abs(&run, "e_residual");
+    let worst = column_max_abs(&run, Channel::EResidual);
     (run, worst)
 }
 
 /// Largest |value| of a time-series channel.
-pub fn column_max_abs(run: &cdpr_core::closed_loop::Run, channel: &str) -> f64 {
+pub fn column_max_abs(run: &cdpr_core::runner::Run, channel: Channel) -> f64 {
     let values = run.series.column(channel).unwrap();
     values.iter().fold(0.0f64, |a, v| a.max(v.abs()))
 }

@@ -1,17 +1,9 @@
-//! Time integration, independent of any cable: an [`OdeSystem`] says what y' is; integrators know
-//! nothing else about it. [`Dopri5`] is the paper-faithful explicit reference (ode45 class);
-//! [`GeneralizedAlpha`] the implicit path for stiff second-order systems ([`SecondOrderSystem`]).
-//! Both are driven one accepted step at a time through [`Stepper`], so the runner's sampling and
-//! event location do not depend on the method.
+//! The interfaces between a system and its integrators: an [`OdeSystem`] says what y' is and
+//! integrators know nothing else about it; both integrators are driven one accepted step at a
+//! time through [`Stepper`], so a runner's sampling and event location do not depend on the
+//! method; [`SolverStats`] counts their work and [`MatrixCost`] prices an iteration matrix.
 
-mod dopri5;
-mod generalized_alpha;
-pub mod sparse;
-
-pub use dopri5::{Dopri5, Dopri5Options};
-pub use generalized_alpha::{
-    AlphaCoefficients, GeneralizedAlpha, GeneralizedAlphaOptions, SecondOrderSystem,
-};
+use crate::sparse;
 
 /// What one evaluation of an implicit method's iteration matrix cost, in two parts kept apart:
 /// the full residual evaluations it made (counted in [`SolverStats::rhs_evals`], which MODELS.md

@@ -2,7 +2,9 @@
 //! error naming the key, its value and the allowed range; unknown keys, malformed TOML and wrong
 //! types are syntax errors naming the culprit; nothing panics.
 
-use cdpr_core::scenario::{Scenario, ScenarioError};
+use cdpr_bench::ModelConfig;
+use cdpr_bench::core::scenario::{Scenario, ScenarioError};
+use cdpr_bench::{scenario_from_file, scenario_from_toml_str};
 use proptest::prelude::*;
 use proptest::test_runner::{TestCaseError, TestRunner};
 use std::cell::Cell;
@@ -10,7 +12,7 @@ use std::cell::Cell;
 /// Parses `toml` and expects `OutOfRange` for `key`, with the value reported as `value`.
 #[track_caller]
 fn expect_out_of_range(toml: &str, key: &str, value: f64) {
-    match Scenario::from_toml_str(toml) {
+    match scenario_from_toml_str(toml) {
         Err(e @ ScenarioError::OutOfRange { .. }) => {
             let msg = e.to_string();
             let ScenarioError::OutOfRange {
@@ -183,7 +185,7 @@ fn every_numeric_key_is_covered() {
             _ => "3.0",
         };
         let text = file("", key, literal);
-        let s = Scenario::from_toml_str(&text)
+        let s = scenario_from_toml_str(&text)
             .unwrap_or_else(|e| panic!("valid value refused for {key}: {e}"));
         assert_ne!(s, Scenario::paper(), "{key} was not read");
     }
@@ -202,7 +204,7 @@ fn elements_out_of_range() {
     }
     // A float where an integer is expected is a type error, not a silent truncation.
     assert!(matches!(
-        Scenario::from_toml_str("[model]\nelements = 10.5"),
+        scenario_from_toml_str("[model]\nelements = 10.5"),
         Err(ScenarioError::Syntax(_))
     ));
 }
@@ -210,7 +212,7 @@ fn elements_out_of_range() {
 #[test]
 fn lumped_modelled_length_must_cover_the_trajectory() {
     // The paper's 1.0 m suffices; 0.5 m cannot reach x2 = 0.6 m from A1.
-    Scenario::from_toml_str("[model]\nkind = \"lumped\"\n[cable]\nmodelled_length = 1.0").unwrap();
+    scenario_from_toml_str("[model]\nkind = \"lumped\"\n[cable]\nmodelled_length = 1.0").unwrap();
     expect_out_of_range(
         "[model]\nkind = \"lumped\"\n[cable]\nmodelled_length = 0.5",
         "cable.modelled_length",
@@ -222,14 +224,14 @@ fn lumped_modelled_length_must_cover_the_trajectory() {
         0.6,
     );
     // The elastic model stores no cable: the length is not constrained beyond > 0.
-    Scenario::from_toml_str("[cable]\nmodelled_length = 0.5").unwrap();
+    scenario_from_toml_str("[cable]\nmodelled_length = 0.5").unwrap();
 }
 
 #[test]
 fn trajectory_outside_the_workspace_names_x2() {
     expect_out_of_range("[trajectory]\nx2 = 1.2", "trajectory.x2", 1.2);
     // The workspace follows anchor_distance: 1.2 is fine between pulleys 2 m apart...
-    Scenario::from_toml_str("[robot]\nanchor_distance = 2.0\n[trajectory]\nx2 = 1.2").unwrap();
+    scenario_from_toml_str("[robot]\nanchor_distance = 2.0\n[trajectory]\nx2 = 1.2").unwrap();
     // ...and x1 is checked against it too.
     expect_out_of_range(
         "[robot]\nanchor_distance = 0.4\n[trajectory]\nx2 = 0.3",
@@ -240,7 +242,7 @@ fn trajectory_outside_the_workspace_names_x2() {
 
 #[track_caller]
 fn expect_syntax(toml: &str, must_contain: &[&str]) {
-    match Scenario::from_toml_str(toml) {
+    match scenario_from_toml_str(toml) {
         Err(e @ ScenarioError::Syntax(_)) => {
             let msg = e.to_string();
             for word in must_contain {
@@ -274,7 +276,7 @@ fn syntax_errors_name_the_culprit() {
 #[test]
 fn missing_file_is_an_io_error() {
     let path = std::env::temp_dir().join("cdpr-bench-no-such-dir/missing-scenario.toml");
-    match Scenario::from_file(&path) {
+    match scenario_from_file(&path) {
         Err(e @ ScenarioError::Io { .. }) => {
             assert!(e.to_string().contains("missing-scenario.toml"), "{e}");
         }
@@ -288,10 +290,10 @@ fn file_round_trip() {
     std::fs::create_dir_all(&dir).unwrap();
     let good = dir.join("good.toml");
     std::fs::write(&good, "[trajectory]\nx2 = 0.7\n").unwrap();
-    assert_eq!(Scenario::from_file(&good).unwrap().trajectory.x2, 0.7);
+    assert_eq!(scenario_from_file(&good).unwrap().trajectory.x2, 0.7);
     let bad = dir.join("bad.toml");
     std::fs::write(&bad, "[trajectory]\nx2 = 0.0\n").unwrap();
-    let err = Scenario::from_file(&bad);
+    let err = scenario_from_file(&bad);
     std::fs::remove_dir_all(&dir).unwrap();
     assert!(
         matches!(
@@ -400,7 +402,7 @@ fn any_scenario_text() -> impl Strategy<Value = String> {
 /// Checks one file: it validates into §9's ranges or is refused with a range error naming a key.
 /// Returns whether it validated.
 fn check_file(text: &str) -> Result<bool, TestCaseError> {
-    match Scenario::from_toml_str(text) {
+    match scenario_from_toml_str(text) {
         Ok(s) => {
             let (r, c, k, t, m) = (
                 &s.robot,
@@ -428,7 +430,7 @@ fn check_file(text: &str) -> Result<bool, TestCaseError> {
             prop_assert!((1e-14..=0.1).contains(&m.rtol) && m.atol > 0.0 && m.step > 0.0);
             prop_assert!((0.0..=0.2).contains(&m.dopri_beta));
             prop_assert!((0.0..=1.0).contains(&m.rho_inf));
-            if let Some(n) = s.model.elements {
+            if let Some(n) = ModelConfig::from_scenario(&s).unwrap().elements {
                 prop_assert!((1..=100_000).contains(&n));
             }
             Ok(true)

@@ -24,8 +24,9 @@
 //! rule. Dense output is the cubic Hermite interpolant of the state and its derivative at both ends
 //! of the step (one right-hand-side evaluation per step), third order, above the method's own.
 
-use super::sparse::IterationMatrix;
-use super::{IntegratorError, MatrixCost, OdeSystem, SolverStats, Stepper};
+use crate::norms::max_norm;
+use crate::ode::{IntegratorError, MatrixCost, OdeSystem, SolverStats, Stepper};
+use crate::sparse::IterationMatrix;
 
 /// A second-order system with a first-order tail, as the implicit integrator sees it.
 ///
@@ -441,32 +442,6 @@ impl GeneralizedAlpha {
     }
 }
 
-/// max |r_i|, or the index of the first non-finite r_i. Four independent lanes (this runs at
-/// every Newton iteration, and a sequential max is one chain of dependent instructions); a max is
-/// exact, so the lanes change no bit of the norm. Non-finite entries are caught by a lane sum of
-/// r_i · 0, which is NaN exactly when some r_i is NaN or infinite.
-fn max_norm(r: &[f64]) -> Result<f64, usize> {
-    let (mut largest, mut poison) = ([0.0f64; 4], [0.0f64; 4]);
-    let chunks = r.chunks_exact(4);
-    let tail = chunks.remainder();
-    for chunk in chunks {
-        for ((m, p), &v) in largest.iter_mut().zip(&mut poison).zip(chunk) {
-            let a = v.abs();
-            *m = if a > *m { a } else { *m };
-            *p += v * 0.0;
-        }
-    }
-    for &v in tail {
-        largest[0] = largest[0].max(v.abs());
-        poison[0] += v * 0.0;
-    }
-    if poison.iter().sum::<f64>().is_finite() {
-        Ok(largest.into_iter().fold(0.0, f64::max))
-    } else {
-        Err(r.iter().position(|v| !v.is_finite()).unwrap_or(0))
-    }
-}
-
 impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
     fn start(
         &mut self,
@@ -654,30 +629,5 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
 
     fn stats(&self) -> SolverStats {
         GeneralizedAlpha::stats(self)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use proptest::prelude::*;
-
-    proptest! {
-        /// The four-lane norm is the plain max |r_i| bit for bit, and a NaN or infinity anywhere
-        /// is reported at its first index.
-        #[test]
-        fn max_norm_is_the_plain_max_and_finds_the_first_non_finite(
-            r in prop::collection::vec(-1e3f64..1e3, 0..40),
-            bad in prop::option::of((0usize..40, prop::bool::ANY)),
-        ) {
-            let plain = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            prop_assert_eq!(max_norm(&r), Ok(plain));
-            if let Some((at, nan)) = bad.filter(|&(at, _)| at < r.len()) {
-                let mut r = r.clone();
-                r[at] = if nan { f64::NAN } else { f64::NEG_INFINITY };
-                let first = r.iter().position(|v| !v.is_finite()).unwrap();
-                prop_assert_eq!(max_norm(&r), Err(first));
-            }
-        }
     }
 }

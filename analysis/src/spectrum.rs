@@ -125,7 +125,10 @@ impl Spectrum {
 
     /// The `count` largest local maxima with ω > `min_omega` (refined), largest first.
     pub fn local_maxima_above(&self, min_omega: f64, count: usize) -> Vec<Peak> {
-        let k0 = ((min_omega / self.omega_step).floor() as usize + 1).max(1);
+        // An empty record has an infinite bin width: no bin lies above min_omega then.
+        let k0 = ((min_omega / self.omega_step).floor() as usize)
+            .saturating_add(1)
+            .max(1);
         let a = &self.amplitude;
         let mut bins: Vec<usize> = (k0..a.len().saturating_sub(1))
             .filter(|&k| a[k] > a[k - 1] && a[k] >= a[k + 1])

@@ -3,7 +3,7 @@
 //! (convergence order of the steps and of the dense output, tolerance proportionality), and the
 //! documented behaviour of the norm exclusion, the failure modes and `restart` (MODELS.md §6).
 
-use cdpr_core::integrate::{Dopri5, Dopri5Options, IntegratorError, OdeSystem};
+use cdpr_numerics::{Dopri5, Dopri5Options, IntegratorError, OdeSystem};
 use proptest::prelude::*;
 
 // ---------------------------------------------------------------------------------------------

@@ -104,7 +104,7 @@ impl Triangle {
     #[inline]
     fn more(&self, i: usize, x: &[f64]) -> f64 {
         let range = self.more_ptr[i]..self.more_ptr[i + 1];
-        super::gathered_dot(&self.more_col[range.clone()], &self.more_val[range], x)
+        super::layout::gathered_dot(&self.more_col[range.clone()], &self.more_val[range], x)
     }
 }
 

@@ -2,7 +2,7 @@
 //! linear oscillator and on the nonlinear Kepler problem for every ρ∞, the numerical damping the
 //! method promises, the trapezoidal first-order tail, and its cost counters.
 
-use cdpr_core::integrate::{
+use cdpr_numerics::{
     GeneralizedAlpha, GeneralizedAlphaOptions, MatrixCost, OdeSystem, SecondOrderSystem, Stepper,
 };
 use proptest::prelude::*;
@@ -256,7 +256,7 @@ fn rho_one_keeps_the_oscillator_amplitude() {
 /// the lumped axial mode at the paper's step (MODELS.md FE.9.3 quotes 5731 rad/s for FE's 5895).
 #[test]
 fn discrete_mode_matches_the_integrated_oscillator() {
-    use cdpr_core::integrate::AlphaCoefficients;
+    use cdpr_numerics::AlphaCoefficients;
     let (omega, h, rho_inf) = (5649.0, 1e-4, 0.9);
     let (predicted, growth) = AlphaCoefficients::new(rho_inf).discrete_mode(omega, h);
     assert!((predicted - 5503.85).abs() < 0.1, "{predicted}");

@@ -6,7 +6,7 @@
 //! The integrator is driven one accepted step at a time so that a caller can sample the dense output,
 //! look for events and restart with a changed state between steps.
 
-use super::{IntegratorError, OdeSystem, SolverStats};
+use crate::ode::{IntegratorError, OdeSystem, SolverStats, Stepper};
 
 // Butcher tableau (dopri5.f, CDOPRI).
 const C2: f64 = 0.2;
@@ -452,7 +452,7 @@ impl Dopri5 {
     }
 }
 
-impl<S: OdeSystem> super::Stepper<S> for Dopri5 {
+impl<S: OdeSystem> Stepper<S> for Dopri5 {
     fn start(
         &mut self,
         sys: &mut S,

@@ -5,9 +5,10 @@
 //! means over the last second [t_final − 1, t_final] (= [4, 5] s for the paper), spectra over
 //! [1 s, t_final) and the whole record [0, t_final].
 
-use crate::closed_loop::Run;
 use crate::spectrum::{Peak, Spectrum, Window};
-use crate::trajectory::Step5;
+use cdpr_core::channel::Channel;
+use cdpr_core::runner::Run;
+use cdpr_core::trajectory::Step5;
 
 /// Start of the settled window of the paper ("after 1 s") [s].
 pub const SETTLED_FROM: f64 = 1.0;
@@ -155,14 +156,15 @@ impl Metrics {
     /// Computes every metric of `run` sampled every `dt` [s] on the trajectory `step5`.
     pub fn from_run(run: &Run, step5: &Step5, dt: f64) -> Self {
         let s = &run.series;
-        let col = |name: &str| s.column(name).unwrap_or_default();
+        // Every run has the common channels; an empty record gives empty columns.
+        let col = |channel: Channel| s.column(channel).unwrap_or_default();
         let (t, x, z, err, t1, t2) = (
-            col("t"),
-            col("x"),
-            col("z"),
-            col("error"),
-            col("T1"),
-            col("T2"),
+            col(Channel::Time),
+            col(Channel::X),
+            col(Channel::Z),
+            col(Channel::Error),
+            col(Channel::T1),
+            col(Channel::T2),
         );
         let t_end = t.last().copied().unwrap_or(0.0);
 
@@ -200,7 +202,7 @@ impl Metrics {
             .into_iter()
             .map(|p| [p.omega, db(p)])
             .collect();
-        let energy_residual_max = max_abs(&col("e_residual"));
+        let energy_residual_max = max_abs(&col(Channel::EResidual));
         let mut last_event = [f64::NEG_INFINITY; 2];
         let mut pulley_chatter = 0;
         for e in &run.events {

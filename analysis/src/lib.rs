@@ -1,0 +1,33 @@
+//! # cdpr-analysis
+//!
+//! What cdpr-bench measures in a run and around an equilibrium, knowing no cable model: amplitude
+//! spectra ([`spectrum`]), the metrics of MODELS.md §7 ([`metrics`]), the closed loop's
+//! linearisation and its modes ([`linearise`]), their classification ([`modes`]) and the
+//! stability margins built on them ([`damping`]).
+//!
+//! Why a crate of its own: these read a run or a linearised loop and never take part in one, so
+//! the core (the robot and its runner) stays free of FFTs and eigen-solvers, and an analysis can
+//! be added without touching what is simulated.
+
+pub mod damping;
+pub mod linearise;
+pub mod metrics;
+pub mod modes;
+pub mod spectrum;
+
+use cdpr_core::model::ModelError;
+use cdpr_numerics::eigen::{EvdError, ModalError};
+
+/// Why an analysis could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum AnalysisError {
+    /// The model refused the state or found no equilibrium.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error("eigenvalue computation failed: {0:?}")]
+    Eigen(EvdError),
+    #[error(transparent)]
+    Modal(#[from] ModalError),
+    #[error("no oscillatory closed-loop mode found")]
+    NoMode,
+}

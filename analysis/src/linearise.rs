@@ -1,0 +1,154 @@
+//! Linearisation of the closed loop about its rest state at an effector position: the
+//! fourth-order finite-difference Jacobian of model + PID + tension distribution
+//! (`cdpr_numerics::differences::jacobian_within`), the coordinates a constraint holds fixed
+//! dropped ([`cdpr_numerics::eigen::reduce`]), and every eigenpair classified
+//! ([`crate::modes::classify`]).
+//!
+//! The elastic model's Jacobian has a closed form (the geometric stiffness Σ T_i/l_i (I − e_i
+//! e_iᵀ), MODELS.md §3); it is the test oracle for this path (`verify/tests/modes.rs`) rather
+//! than a second code path. Constrained coordinates (the lumped model's stored nodes, z = ż = 0,
+//! MODELS.md §4) have zero rows and columns that act on perturbations the constraint forbids, so
+//! they are dropped before the eigen-analysis; the eigenvectors are mapped back with zeros there.
+//! Open loop (tensions fixed at the equilibrium's), the PID states are dropped too: they integrate
+//! the error but do not act.
+
+use crate::AnalysisError;
+use crate::modes::{Analysis, ClassifiedMode, Loop, classify};
+use cdpr_core::Vector2;
+use cdpr_core::closed_loop::{Actuation, ClosedLoop};
+use cdpr_core::model::{CableModel, Equilibrium};
+use cdpr_core::scenario::Scenario;
+use cdpr_core::trajectory::Step5;
+use cdpr_numerics::differences::{jacobian, jacobian_within};
+use cdpr_numerics::eigen::{Mode, mode_shapes, modes, nearest_mode, reduce};
+use faer::Mat;
+
+/// Jacobian ∂y'/∂y of the closed loop (model and PID states; the audit states are left out) at
+/// (t, y) by central differences ([`jacobian`] for the step rule).
+pub fn closed_loop_jacobian<M: CableModel>(sys: &mut ClosedLoop<M>, t: f64, y: &[f64]) -> Mat<f64> {
+    let n = sys.model_len() + 2;
+    jacobian(sys, t, y, n)
+}
+
+/// A linearisation with the raw eigenvectors kept (for perturbing a nonlinear run along a mode).
+pub struct Linearised {
+    pub analysis: Analysis,
+    /// Closed-loop state of the equilibrium (model | w | f | W | D).
+    pub state: Vec<f64>,
+    /// For each mode of `analysis.modes` (same order), its eigenvector mapped back to the model and
+    /// PID states of `state` (zeros on frozen coordinates and, open loop, on the PID states).
+    pub vectors: Vec<Vec<(f64, f64)>>,
+}
+
+/// Modal analysis of `model` in the scenario's closed loop at effector position `x` [m]: the
+/// static equilibrium of MODELS.md §2 there, with the reference held at x.
+pub fn linearise<M: CableModel>(
+    model: M,
+    scenario: &Scenario,
+    x: f64,
+    feedback: Loop,
+) -> Result<Linearised, AnalysisError> {
+    let mut sys = ClosedLoop::new(model, scenario);
+    // Hold the reference at x: the loop is then autonomous and x is its equilibrium.
+    sys.trajectory = Step5 {
+        x1: x,
+        x2: x,
+        ..sys.trajectory
+    };
+    let (y, eq) = sys.rest_state(x)?;
+    let tensions = sys.distribution.tensions(eq.force);
+    if feedback == Loop::Open {
+        sys.actuation = Actuation::Prescribed(Box::new(move |_| tensions));
+    }
+    let n = sys.model_len();
+    let np = n / 2;
+    let layout = sys.model.modal_layout(&eq.state);
+    let free: Vec<usize> = (0..np).filter(|i| !layout.frozen.contains(i)).collect();
+    let mut keep: Vec<usize> = free
+        .iter()
+        .copied()
+        .chain(free.iter().map(|i| np + i))
+        .collect();
+    if feedback == Loop::Closed {
+        keep.extend([n, n + 1]);
+    }
+    // The stencil stays where the forces are smooth, as the models' own iteration matrices do:
+    // on fine meshes the springs' stretch falls below the default reach (lumped N = 200 at
+    // x = 0.5: ≈ 2.8e-6 m against 3e-6·|x|) and the slack side under-reads the axial stiffness.
+    let mut reach = vec![f64::INFINITY; n + 2];
+    if let Some(form) = sys.model.second_order() {
+        form.smooth_reach(&y[..n], &mut reach[..np]);
+    }
+    // Velocities at rest: a step scale of 1 m/s (the step5 peak speed is 0.94 m/s), see
+    // `cdpr_numerics::differences::jacobian_within`.
+    let mut scale = vec![1e-3; n + 2];
+    scale[np..n].fill(1.0);
+    let jac = jacobian_within(&mut sys, 0.0, &y, n + 2, &reach, &scale);
+    let shapes = mode_shapes(&reduce(&jac, &keep))?;
+    let mut modes = Vec::with_capacity(shapes.len());
+    let mut vectors = Vec::with_capacity(shapes.len());
+    for shape in &shapes {
+        let mut full = vec![(0.0, 0.0); n + 2];
+        for (k, &i) in keep.iter().enumerate() {
+            full[i] = shape.vector[k];
+        }
+        let (kind, purity) = classify(&layout, &full[..np]);
+        modes.push(ClassifiedMode {
+            mode: shape.mode,
+            kind,
+            order: 0,
+            purity,
+        });
+        vectors.push(full);
+    }
+    let mut counts = std::collections::HashMap::new();
+    for m in &mut modes {
+        let c = counts.entry(m.kind).or_insert(0);
+        *c += 1;
+        m.order = *c;
+    }
+    let p = sys.model.effector(&eq.state).position;
+    Ok(Linearised {
+        analysis: Analysis {
+            model: sys.model.name(),
+            x: p.x,
+            z: p.y,
+            feedback,
+            tensions,
+            modes,
+        },
+        state: y,
+        vectors,
+    })
+}
+
+/// The settled end of the move: the static equilibrium at x2 and the closed-loop mode there.
+#[derive(Debug, Clone)]
+pub struct EndState {
+    /// Closed-loop mode nearest the guess (eq. 15 for the vertical mode).
+    pub mode: Mode,
+    /// Static equilibrium at x2 (MODELS.md §2 rule).
+    pub equilibrium: Equilibrium,
+    /// Effector position there [m].
+    pub effector: Vector2<f64>,
+}
+
+/// [`EndState`] of `sys` at the trajectory's x2: the closed-loop mode nearest `omega_guess`
+/// [rad/s], from the finite-difference Jacobian of model + PID + tension distribution.
+pub fn end_state<M: CableModel>(
+    mut sys: ClosedLoop<M>,
+    omega_guess: f64,
+) -> Result<EndState, AnalysisError> {
+    let (y, eq) = sys.rest_state(sys.trajectory.x2)?;
+    // After t2 the reference is constant: the loop is autonomous there.
+    let t = sys.trajectory.t2 + 1.0;
+    let jac = closed_loop_jacobian(&mut sys, t, &y);
+    let modes = modes(&jac).map_err(AnalysisError::Eigen)?;
+    let mode = nearest_mode(&modes, omega_guess).ok_or(AnalysisError::NoMode)?;
+    let effector = sys.model.effector(&eq.state).position;
+    Ok(EndState {
+        mode,
+        equilibrium: eq,
+        effector,
+    })
+}

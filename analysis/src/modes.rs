@@ -1,0 +1,147 @@
+//! Every mode of a model at one effector position, classified from its eigenvector as effector
+//! vertical, effector horizontal / controller, transverse string mode of cable 1 or 2, or axial
+//! mode of cable 1 or 2, by the share of the mass-weighted displacement each holds. The model says
+//! what its coordinates are ([`cdpr_core::modal_layout::ModalLayout`]); this module knows no model.
+
+use cdpr_core::modal_layout::{Dof, ModalLayout};
+use cdpr_numerics::eigen::Mode;
+
+/// What a mode is, by the largest share of its mass-weighted displacement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+pub enum ModeKind {
+    /// The effector bouncing on the cables (eq. 15's mode).
+    Vertical,
+    /// The effector sliding along the workspace; in closed loop these are the PID's x poles.
+    Horizontal,
+    /// Transverse string mode of cable 1 or 2.
+    Transverse(usize),
+    /// Axial (stretch) mode of cable 1 or 2.
+    Axial(usize),
+}
+
+impl std::fmt::Display for ModeKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ModeKind::Vertical => write!(f, "effector vertical"),
+            ModeKind::Horizontal => write!(f, "effector horizontal / controller"),
+            ModeKind::Transverse(c) => write!(f, "transverse cable {}", c + 1),
+            ModeKind::Axial(c) => write!(f, "axial cable {}", c + 1),
+        }
+    }
+}
+
+/// One mode of one model, classified.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ClassifiedMode {
+    pub mode: Mode,
+    pub kind: ModeKind,
+    /// 1-based rank among the modes of the same kind, by frequency (the k of ω_k).
+    pub order: usize,
+    /// Share of the mass-weighted |displacement|² that `kind` holds (1: pure).
+    pub purity: f64,
+}
+
+/// Whether the PID acts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Loop {
+    /// The paper's PID and tension distribution.
+    Closed,
+    /// Tensions fixed at the equilibrium's, PID states dropped.
+    Open,
+}
+
+/// Every mode of a model at one effector position.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Analysis {
+    pub model: &'static str,
+    /// Effector x [m] of the static equilibrium.
+    pub x: f64,
+    /// Effector z [m] there.
+    pub z: f64,
+    pub feedback: Loop,
+    /// Commanded tensions at the equilibrium [N].
+    pub tensions: [f64; 2],
+    /// Modes sorted by frequency (one of each conjugate pair; real modes have ω = 0).
+    pub modes: Vec<ClassifiedMode>,
+}
+
+impl Analysis {
+    /// The fastest-growing mode (largest σ).
+    pub fn least_stable(&self) -> Option<&ClassifiedMode> {
+        self.modes
+            .iter()
+            .max_by(|a, b| a.mode.growth.total_cmp(&b.mode.growth))
+    }
+
+    /// The `order`-th mode (1-based) of `kind`.
+    pub fn find(&self, kind: ModeKind, order: usize) -> Option<&ClassifiedMode> {
+        self.modes
+            .iter()
+            .find(|m| m.kind == kind && m.order == order)
+    }
+
+    /// The oscillatory vertical mode (the lowest of that kind).
+    pub fn vertical(&self) -> Option<&ClassifiedMode> {
+        self.modes
+            .iter()
+            .find(|m| m.kind == ModeKind::Vertical && m.mode.omega > 0.0)
+    }
+}
+
+/// The kind holding the largest share of Σ m |u|² over the position part `u` of an eigenvector,
+/// and that share. Effector: x → horizontal, z → vertical; a free node: its component along the
+/// cable tangent → axial, across → transverse; an axial coordinate → axial.
+pub fn classify(layout: &ModalLayout, u: &[(f64, f64)]) -> (ModeKind, f64) {
+    let abs2 = |(re, im): (f64, f64)| re * re + im * im;
+    // [vertical, horizontal, transverse 1, transverse 2, axial 1, axial 2]
+    let mut share = [0.0f64; 6];
+    for dof in &layout.dofs {
+        match *dof {
+            Dof::Effector { x, z, mass } => {
+                share[1] += mass * abs2(u[x]);
+                share[0] += mass * abs2(u[z]);
+            }
+            Dof::Node {
+                cable,
+                x,
+                z,
+                tangent: t,
+                mass,
+            } => {
+                let along = (t.x * u[x].0 + t.y * u[z].0, t.x * u[x].1 + t.y * u[z].1);
+                let across = (-t.y * u[x].0 + t.x * u[z].0, -t.y * u[x].1 + t.x * u[z].1);
+                share[4 + cable] += mass * abs2(along);
+                share[2 + cable] += mass * abs2(across);
+            }
+            Dof::Axial { cable, index, mass } => share[4 + cable] += mass * abs2(u[index]),
+        }
+    }
+    let total: f64 = share.iter().sum();
+    let (best, &value) = share
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .expect("six shares");
+    let kind = match best {
+        0 => ModeKind::Vertical,
+        1 => ModeKind::Horizontal,
+        2 | 3 => ModeKind::Transverse(best - 2),
+        _ => ModeKind::Axial(best - 4),
+    };
+    // No displacement at all (a pure controller-state mode): the controller's x loop.
+    if total == 0.0 {
+        return (ModeKind::Horizontal, 1.0);
+    }
+    (kind, value / total)
+}
+
+/// Taut-string transverse frequency ω_k = (kπ/l)√(T/μ_s) [rad/s] of a span of chord `length` l
+/// [m] under tension `tension` T [N], μ_s = μ/(1 + T/EA) the mass per stretched length.
+pub fn taut_string(k: usize, length: f64, tension: f64, mu: f64, ea: f64) -> f64 {
+    let mu_s = mu / (1.0 + tension / ea);
+    k as f64 * std::f64::consts::PI / length * (tension / mu_s).sqrt()
+}
+
+/// Modes below this frequency [rad/s] are the physically relevant band (MODELS.md FE.9.1: the
+/// effector, string and lowest axial modes); above it lie the discretisation's axial modes.
+pub const RELEVANT_BAND: f64 = 1e4;

@@ -1,0 +1,488 @@
+//! The runner: integrates a [`ClosedLoop`] from its MODELS.md §2 initial state with the
+//! scenario's integrator, samples it on the dense output, locates and applies the model's events,
+//! and stops with a reason ([`RunError`]) while keeping what it sampled ([`RunFailure`]).
+
+use crate::channel::Channel;
+use crate::closed_loop::ClosedLoop;
+use crate::model::{CableModel, Equilibrium, ModelError, ModelEvent};
+use crate::scenario::{IntegratorKind, Scenario};
+use crate::series::TimeSeries;
+use cdpr_numerics::{
+    Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions, IntegratorError, SolverStats,
+    Stepper,
+};
+use std::time::Instant;
+
+/// Why a run stopped early.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RunError {
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error("integrator failed at t = {t} s: {source}")]
+    Integrator {
+        t: f64,
+        #[source]
+        source: IntegratorError,
+    },
+    /// A commanded tension ≤ 0 (MODELS.md §2): a cable cannot push.
+    #[error("cable {cable} went slack at t = {t} s: commanded tension {tension} N ≤ 0")]
+    SlackCable { t: f64, cable: usize, tension: f64 },
+    /// The scenario asks for an integrator the model does not support.
+    #[error(
+        "simulation.integrator = \"{integrator}\" is not available for the {model} model: {why}"
+    )]
+    Unsupported {
+        integrator: &'static str,
+        model: &'static str,
+        why: &'static str,
+    },
+}
+
+/// Output of a run: sampled channels, counters, the initial equilibrium, the state at the end.
+#[derive(Clone)]
+pub struct Run {
+    pub model: &'static str,
+    pub series: TimeSeries,
+    pub stats: SolverStats,
+    pub equilibrium: Equilibrium,
+    /// Closed-loop state at the last accepted step (model | w | f | W | D).
+    pub final_state: Vec<f64>,
+    /// Time reached [s] (t_final unless the run failed).
+    pub t_reached: f64,
+    /// Model events (e.g. lumped nodes passing a pulley), in time order.
+    pub events: Vec<ModelEvent>,
+    /// Wall-clock time of the integration [s] (the only non-reproducible number of a run).
+    pub wall_s: f64,
+}
+
+/// A summary, not the samples (a failed `unwrap` would otherwise print megabytes).
+impl std::fmt::Debug for Run {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Run")
+            .field("model", &self.model)
+            .field("samples", &self.series.len())
+            .field("channels", &self.series.names())
+            .field("t_reached", &self.t_reached)
+            .field("stats", &self.stats)
+            .field("events", &self.events.len())
+            .field("wall_s", &self.wall_s)
+            .finish_non_exhaustive()
+    }
+}
+
+/// A failed run: the reason and everything sampled before it.
+#[derive(Debug, Clone)]
+pub struct RunFailure {
+    pub error: RunError,
+    pub partial: Option<Run>,
+}
+
+impl std::fmt::Display for RunFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.error)?;
+        if let Some(run) = &self.partial {
+            write!(
+                f,
+                " (output kept up to t = {} s, {} samples)",
+                run.t_reached,
+                run.series.len()
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for RunFailure {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        Some(&self.error)
+    }
+}
+
+/// How to integrate and sample a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunOptions {
+    pub t_final: f64,
+    pub sample_period: f64,
+    pub integrator: IntegratorKind,
+    pub dopri: Dopri5Options,
+    pub implicit: GeneralizedAlphaOptions,
+}
+
+impl RunOptions {
+    /// A DOPRI5 run to `t_final` [s], sampled every `sample_period` [s] (tests and studies that
+    /// set the tolerances themselves).
+    pub fn dopri5(t_final: f64, sample_period: f64, dopri: Dopri5Options) -> Self {
+        Self {
+            t_final,
+            sample_period,
+            integrator: IntegratorKind::Dopri5,
+            dopri,
+            implicit: GeneralizedAlphaOptions::default(),
+        }
+    }
+}
+
+impl From<&Scenario> for RunOptions {
+    fn from(s: &Scenario) -> Self {
+        let sim = &s.simulation;
+        Self {
+            t_final: sim.t_final,
+            sample_period: sim.sample_period,
+            integrator: sim.integrator,
+            dopri: Dopri5Options {
+                rtol: sim.rtol,
+                atol: sim.atol,
+                beta: sim.dopri_beta,
+                ..Dopri5Options::default()
+            },
+            implicit: GeneralizedAlphaOptions {
+                step: sim.step,
+                rho_inf: sim.rho_inf,
+                ..GeneralizedAlphaOptions::default()
+            },
+        }
+    }
+}
+
+/// Integrates the loop from its MODELS.md §2 initial state to `t_final`, sampling every
+/// `sample_period` on the dense output. `progress` receives the fraction of time done after each
+/// accepted step.
+pub fn simulate<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Run, Box<RunFailure>> {
+    simulate_reusing(sys, opts, Vec::new(), progress)
+}
+
+/// As [`simulate`], writing the samples into `buffer`'s memory (from [`TimeSeries::into_buffer`]
+/// of an earlier run): sweeps and benches then allocate their output once.
+pub fn simulate_reusing<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+    opts: &RunOptions,
+    buffer: Vec<f64>,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Run, Box<RunFailure>> {
+    let (y0, equilibrium) = sys.initial_state().map_err(|e| {
+        Box::new(RunFailure {
+            error: e.into(),
+            partial: None,
+        })
+    })?;
+    integrate_and_sample(sys, y0, equilibrium, opts, buffer, progress)
+}
+
+/// As [`simulate`], from a given closed-loop state `y0` at t = 0 (`equilibrium` is reported as the
+/// run's starting point).
+pub fn simulate_from<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+    y0: Vec<f64>,
+    equilibrium: Equilibrium,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Run, Box<RunFailure>> {
+    integrate_and_sample(sys, y0, equilibrium, opts, Vec::new(), progress)
+}
+
+fn integrate_and_sample<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+    y0: Vec<f64>,
+    equilibrium: Equilibrium,
+    opts: &RunOptions,
+    buffer: Vec<f64>,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Run, Box<RunFailure>> {
+    let start = Instant::now();
+    let n = sys.model_len();
+    let mut names: Vec<String> = Channel::COMMON.map(|c| c.name().to_owned()).to_vec();
+    names.extend(sys.model.channel_names());
+    names.extend(Channel::ENERGY.map(|c| c.name().to_owned()));
+    let samples = (opts.t_final / opts.sample_period).round() as usize + 1;
+    let mut sampler = Sampler {
+        series: TimeSeries::with_buffer(names, samples, buffer),
+        y: vec![0.0; y0.len()],
+        model_channels: sys.model.channel_names().len(),
+        energy0: sys.model.energy(&y0[..n]).total(),
+        event_energy: 0.0,
+        next: 0,
+        samples,
+        period: opts.sample_period,
+        t_final: opts.t_final,
+    };
+    let mut events = Vec::new();
+    let mut dopri;
+    let mut alpha;
+    let stepper: &mut dyn Stepper<ClosedLoop<M>> = match opts.integrator {
+        IntegratorKind::Dopri5 => {
+            dopri = Dopri5::new(
+                y0.len(),
+                Dopri5Options {
+                    norm_components: Some(n + 2),
+                    ..opts.dopri
+                },
+            );
+            &mut dopri
+        }
+        IntegratorKind::Implicit => {
+            alpha = GeneralizedAlpha::new(opts.implicit);
+            &mut alpha
+        }
+    };
+    let outcome =
+        if opts.integrator == IntegratorKind::Implicit && sys.model.second_order().is_none() {
+            Err(RunError::Unsupported {
+                integrator: IntegratorKind::Implicit.name(),
+                model: sys.model.name(),
+                why: "the model offers no second-order form",
+            })
+        } else {
+            integrate(
+                sys,
+                &y0,
+                opts.t_final,
+                stepper,
+                &mut sampler,
+                &mut events,
+                progress,
+            )
+        };
+    let t_reached = if stepper.stats().rhs_evals == 0 {
+        0.0
+    } else {
+        stepper.time()
+    };
+    let run = Run {
+        model: sys.model.name(),
+        series: sampler.series,
+        stats: stepper.stats(),
+        equilibrium,
+        final_state: if t_reached > 0.0 {
+            stepper.state().to_vec()
+        } else {
+            y0
+        },
+        t_reached,
+        events,
+        wall_s: start.elapsed().as_secs_f64(),
+    };
+    match outcome {
+        Ok(()) => Ok(run),
+        Err(error) => Err(Box::new(RunFailure {
+            error,
+            partial: Some(run),
+        })),
+    }
+}
+
+/// The integration loop: accepted steps, located model events, samples, slack checks.
+fn integrate<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+    y0: &[f64],
+    t_end: f64,
+    stepper: &mut dyn Stepper<ClosedLoop<M>>,
+    sampler: &mut Sampler,
+    events: &mut Vec<ModelEvent>,
+    progress: &mut dyn FnMut(f64),
+) -> Result<(), RunError> {
+    let integrator = |t: f64| move |source| RunError::Integrator { t, source };
+    stepper
+        .start(sys, 0.0, y0, t_end)
+        .map_err(integrator(0.0))?;
+    let mut monitor = EventMonitor::new(sys, y0);
+    sampler.sample_through(sys, stepper, 0.0)?;
+    while stepper.time() < t_end {
+        stepper
+            .step(sys, t_end)
+            .map_err(integrator(stepper.time()))?;
+        let Some((index, t_event)) = monitor.earliest_crossing(sys, stepper) else {
+            let t = stepper.time();
+            sampler.sample_through(sys, stepper, t)?;
+            check_slack(t, sys.command(t, stepper.state()).tensions)?;
+            monitor.accept(sys, stepper.state());
+            progress(t / t_end);
+            continue;
+        };
+        // Samples up to the event come from the step as integrated; the event changes the state
+        // there and the integrator restarts from it, abandoning the rest of the step.
+        sampler.sample_through(sys, stepper, t_event)?;
+        let mut y = vec![0.0; y0.len()];
+        stepper.dense_output(t_event, &mut y);
+        let n = sys.model_len();
+        let event = sys.model.apply_event(index, t_event, &mut y[..n])?;
+        sampler.event_energy += event.energy_change;
+        events.push(event);
+        stepper.restart(sys, t_event, &y);
+        check_slack(t_event, sys.command(t_event, &y).tensions)?;
+        monitor.accept(sys, &y);
+    }
+    Ok(())
+}
+
+/// Watches the model's event functions between accepted steps and locates sign changes on the
+/// dense output by bisection to [`EVENT_TIME_TOL`] (MODELS.md §4).
+struct EventMonitor {
+    /// g at the start of the current step.
+    before: Vec<f64>,
+    after: Vec<f64>,
+    probe: Vec<f64>,
+    y: Vec<f64>,
+}
+
+/// Width of the bracket a located event time lies in [s].
+pub const EVENT_TIME_TOL: f64 = 1e-12;
+
+impl EventMonitor {
+    fn new<M: CableModel>(sys: &ClosedLoop<M>, y: &[f64]) -> Self {
+        let k = sys.model.event_count();
+        let mut monitor = Self {
+            before: vec![0.0; k],
+            after: vec![0.0; k],
+            probe: vec![0.0; k],
+            y: vec![0.0; if k > 0 { y.len() } else { 0 }],
+        };
+        monitor.accept(sys, y);
+        monitor
+    }
+
+    /// Takes `y` as the start of the next step.
+    fn accept<M: CableModel>(&mut self, sys: &ClosedLoop<M>, y: &[f64]) {
+        if !self.before.is_empty() {
+            sys.model
+                .event_functions(&y[..sys.model_len()], &mut self.before);
+        }
+    }
+
+    /// The earliest event function that fell from > 0 to ≤ 0 over the last accepted step, with
+    /// the first time at which it is ≤ 0 (to within [`EVENT_TIME_TOL`]).
+    fn earliest_crossing<M: CableModel>(
+        &mut self,
+        sys: &ClosedLoop<M>,
+        stepper: &dyn Stepper<ClosedLoop<M>>,
+    ) -> Option<(usize, f64)> {
+        if self.before.is_empty() {
+            return None;
+        }
+        let n = sys.model_len();
+        sys.model
+            .event_functions(&stepper.state()[..n], &mut self.after);
+        let mut earliest: Option<(usize, f64)> = None;
+        for k in 0..self.before.len() {
+            if !(self.before[k] > 0.0 && self.after[k] <= 0.0) {
+                continue;
+            }
+            let (mut a, mut b) = (stepper.previous_time(), stepper.time());
+            while b - a > EVENT_TIME_TOL {
+                let mid = 0.5 * (a + b);
+                if mid <= a || mid >= b {
+                    break;
+                }
+                stepper.dense_output(mid, &mut self.y);
+                sys.model.event_functions(&self.y[..n], &mut self.probe);
+                if self.probe[k] > 0.0 {
+                    a = mid;
+                } else {
+                    b = mid;
+                }
+            }
+            if earliest.is_none_or(|(_, t)| b < t) {
+                earliest = Some((k, b));
+            }
+        }
+        earliest
+    }
+}
+
+/// A commanded tension ≤ 0 (or NaN) is a slack cable.
+#[inline]
+fn check_slack(t: f64, tensions: [f64; 2]) -> Result<(), RunError> {
+    if tensions[0] > 0.0 && tensions[1] > 0.0 {
+        return Ok(());
+    }
+    let cable = if tensions[0] > 0.0 { 2 } else { 1 };
+    Err(RunError::SlackCable {
+        t,
+        cable,
+        tension: tensions[cable - 1],
+    })
+}
+
+/// Samples the dense output on the grid t_k = k·Δt (computed, not accumulated, so the grid is
+/// exact and reproducible).
+struct Sampler {
+    series: TimeSeries,
+    y: Vec<f64>,
+    /// Number of the model's own channels.
+    model_channels: usize,
+    energy0: f64,
+    /// Sum of the energy changes of the model events so far [J].
+    event_energy: f64,
+    next: usize,
+    samples: usize,
+    period: f64,
+    /// End of the run [s]: the last sample is taken there, when the integration reaches it.
+    t_final: f64,
+}
+
+impl Sampler {
+    /// Appends every grid sample with t_k ≤ `t` (within the last accepted step).
+    fn sample_through<M: CableModel>(
+        &mut self,
+        sys: &ClosedLoop<M>,
+        stepper: &dyn Stepper<ClosedLoop<M>>,
+        t: f64,
+    ) -> Result<(), RunError> {
+        let n = sys.model_len();
+        while self.next < self.samples {
+            let tk = self.next as f64 * self.period;
+            // The last sample is the end point itself (t_final may not be a multiple of Δt by ulps),
+            // taken once the integration has reached it.
+            let tk = if self.next + 1 == self.samples {
+                self.t_final
+            } else {
+                tk
+            };
+            if tk > t {
+                break;
+            }
+            if tk == stepper.time() {
+                self.y.copy_from_slice(stepper.state());
+            } else {
+                stepper.dense_output(tk, &mut self.y);
+            }
+            let y = &self.y;
+            let cmd = sys.command(tk, y);
+            check_slack(tk, cmd.tensions)?;
+            let model_state = &y[..n];
+            let eff = sys.model.effector(model_state);
+            let energy = sys.model.energy(model_state);
+            let (work, dissipated) = (y[n + 2], y[n + 3]);
+            let residual = energy.total() - self.energy0 - work + dissipated - self.event_energy;
+            let m = self.model_channels;
+            self.series.push_row_with(|row| {
+                let (common, rest) = row.split_at_mut(Channel::COMMON.len());
+                let (own, energies) = rest.split_at_mut(m);
+                common.copy_from_slice(&[
+                    tk,
+                    cmd.reference,
+                    eff.position.x,
+                    eff.position.y,
+                    cmd.error,
+                    cmd.force,
+                    cmd.tensions[0],
+                    cmd.tensions[1],
+                ]);
+                sys.model.channels(model_state, cmd.tensions, own);
+                energies.copy_from_slice(&[
+                    energy.kinetic,
+                    energy.elastic,
+                    energy.gravity,
+                    work,
+                    dissipated,
+                    residual,
+                ]);
+            });
+            self.next += 1;
+        }
+        Ok(())
+    }
+}

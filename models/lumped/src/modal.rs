@@ -1,0 +1,50 @@
+//! The lumped model's coordinates for the modal classification: the effector, each free node
+//! with its cable's tangent there, each stored node's x (which moves material along the reel
+//! line) and its z, held at 0 by MODELS.md §4 eq. 6.
+
+use crate::Lumped;
+use cdpr_core::modal_layout::{Dof, ModalLayout};
+
+impl Lumped {
+    /// The coordinates of `y` as the modal analysis classifies them.
+    pub(crate) fn modal_layout_of(&self, y: &[f64]) -> ModalLayout {
+        let n = self.elements;
+        let mut layout = ModalLayout {
+            dofs: vec![Dof::Effector {
+                x: self.xi(0, n),
+                z: self.zi(0, n),
+                mass: self.effector_mass,
+            }],
+            frozen: Vec::new(),
+        };
+        for cable in 0..2 {
+            let r = self.stored()[cable];
+            for j in 0..n {
+                let (x, z) = (self.xi(cable, j), self.zi(cable, j));
+                if j < r {
+                    layout.frozen.push(z);
+                    layout.dofs.push(Dof::Axial {
+                        cable,
+                        index: x,
+                        mass: self.node_mass,
+                    });
+                } else {
+                    let prev = if j == r {
+                        self.pulley(cable)
+                    } else {
+                        self.node(y, cable, j - 1)
+                    };
+                    let next = self.node(y, cable, j + 1);
+                    layout.dofs.push(Dof::Node {
+                        cable,
+                        x,
+                        z,
+                        tangent: (next - prev).normalize(),
+                        mass: self.node_mass,
+                    });
+                }
+            }
+        }
+        layout
+    }
+}

@@ -1,0 +1,94 @@
+//! Building the scenario's cable model: the one place that turns a model kind into a model.
+//!
+//! Generic code runs on any model through a [`ModelVisitor`], monomorphised for each (the
+//! benches and the statics sweep need the concrete type); code that only needs *a* model takes
+//! the boxed one from [`build`].
+
+use crate::config::ModelConfig;
+use crate::kind::ModelKind;
+use cdpr_core::model::{CableModel, ModelError, ModelParams};
+use cdpr_core::scenario::{Scenario, ScenarioError};
+
+/// Why a model could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum BuildError {
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    #[error(transparent)]
+    Model(#[from] ModelError),
+}
+
+/// Generic work on a model of any kind (see [`with_model`]).
+pub trait ModelVisitor {
+    type Output;
+    fn visit<M: CableModel + Clone + Send + 'static>(self, model: M) -> Self::Output;
+}
+
+/// Generic work on the chosen model's parameters.
+trait ParamsVisitor {
+    type Output;
+    fn visit<P: ModelParams>(self, params: P) -> Self::Output;
+}
+
+/// The chosen model's parameters, handed to `visitor`: the kind is matched here and nowhere else.
+fn with_params<V: ParamsVisitor>(
+    config: &ModelConfig,
+    visitor: V,
+) -> Result<V::Output, ScenarioError> {
+    Ok(match config.kind {
+        ModelKind::Elastic => visitor.visit(cdpr_elastic::Params),
+        ModelKind::Lumped => visitor.visit(config.lumped()?),
+        ModelKind::Fe => visitor.visit(config.fe()?),
+    })
+}
+
+/// Builds the scenario's model (after the model's own checks of the scenario) and hands it to
+/// `visitor`.
+pub fn with_model<V: ModelVisitor>(
+    scenario: &Scenario,
+    visitor: V,
+) -> Result<V::Output, BuildError> {
+    struct Build<'a, V>(&'a Scenario, V);
+    impl<V: ModelVisitor> ParamsVisitor for Build<'_, V> {
+        type Output = Result<V::Output, BuildError>;
+        fn visit<P: ModelParams>(self, params: P) -> Self::Output {
+            params.validate(self.0)?;
+            Ok(self.1.visit(params.build(self.0)?))
+        }
+    }
+    with_params(
+        &ModelConfig::from_scenario(scenario)?,
+        Build(scenario, visitor),
+    )?
+}
+
+/// A cable model, whichever the scenario names: what the closed loop runs.
+pub type DynModel = Box<dyn CableModel + Send>;
+
+/// The scenario's cable model.
+pub fn build(scenario: &Scenario) -> Result<DynModel, BuildError> {
+    struct Boxed;
+    impl ModelVisitor for Boxed {
+        type Output = DynModel;
+        fn visit<M: CableModel + Clone + Send + 'static>(self, model: M) -> DynModel {
+            Box::new(model)
+        }
+    }
+    with_model(scenario, Boxed)
+}
+
+/// The chosen model's own checks of the scenario (MODELS.md §9: enough modelled cable for the
+/// trajectory; the elastic model stores no cable and has none).
+pub(crate) fn validate_for_model(
+    scenario: &Scenario,
+    config: &ModelConfig,
+) -> Result<(), ScenarioError> {
+    struct Validate<'a>(&'a Scenario);
+    impl ParamsVisitor for Validate<'_> {
+        type Output = Result<(), ScenarioError>;
+        fn visit<P: ModelParams>(self, params: P) -> Self::Output {
+            params.validate(self.0)
+        }
+    }
+    with_params(config, Validate(scenario))?
+}

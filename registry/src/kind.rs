@@ -1,0 +1,50 @@
+//! Which cable model a run uses: the registry's list of every model.
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// A cable model of cdpr-bench (`[model] kind`, `--model`).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default, Deserialize, Serialize,
+)]
+#[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+pub enum ModelKind {
+    /// Massless elastic springs (paper §2.1, MODELS.md §3).
+    #[default]
+    Elastic,
+    /// Lumped mass-spring cable sliding over the pulley (paper §2.2, MODELS.md §4).
+    Lumped,
+    /// Variable-length finite elements (paper §2.3, MODELS.md §5).
+    Fe,
+}
+
+impl ModelKind {
+    /// Every model, in the order of the paper.
+    pub const ALL: [ModelKind; 3] = [ModelKind::Elastic, ModelKind::Lumped, ModelKind::Fe];
+
+    /// The scenario file's spelling, also the model's name in files and tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Elastic => "elastic",
+            ModelKind::Lumped => "lumped",
+            ModelKind::Fe => "fe",
+        }
+    }
+}
+
+impl fmt::Display for ModelKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for ModelKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| format!("unknown model `{s}`: allowed elastic, lumped, fe"))
+    }
+}

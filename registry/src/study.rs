@@ -1,0 +1,149 @@
+//! Running a scenario with its model: the simulation, its metrics (MODELS.md §7), the settled end
+//! state with its closed-loop vertical mode, and the modal analyses, for whichever model the
+//! scenario names.
+
+use crate::build::{BuildError, ModelVisitor, build, with_model};
+use crate::config::ModelConfig;
+use crate::kind::ModelKind;
+use cdpr_analysis::AnalysisError;
+use cdpr_analysis::damping::{self, Sweep};
+use cdpr_analysis::linearise::{self, EndState, Linearised};
+use cdpr_analysis::metrics::Metrics;
+use cdpr_analysis::modes::{Analysis, Loop};
+use cdpr_core::closed_loop::ClosedLoop;
+use cdpr_core::model::{CableModel, ModelError};
+use cdpr_core::runner::{Run, RunFailure, RunOptions, simulate as run_loop};
+use cdpr_core::scenario::{IntegratorKind, Scenario, ScenarioError};
+use cdpr_core::trajectory::Step5;
+use cdpr_elastic::eq15_frequency;
+use cdpr_numerics::AlphaCoefficients;
+
+/// Why a scenario could not be simulated or analysed.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error(transparent)]
+    Run(#[from] Box<RunFailure>),
+    #[error(transparent)]
+    Analysis(#[from] AnalysisError),
+}
+
+impl From<BuildError> for Error {
+    fn from(e: BuildError) -> Self {
+        match e {
+            BuildError::Scenario(e) => Error::Scenario(e),
+            BuildError::Model(e) => Error::Model(e),
+        }
+    }
+}
+
+/// Simulates the scenario: the MODELS.md §2 initial state, then the scenario's integrator,
+/// sampled every sample period. `progress` receives the fraction of time done.
+pub fn simulate(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Run, Error> {
+    let mut sys = ClosedLoop::new(build(scenario)?, scenario);
+    Ok(run_loop(&mut sys, &RunOptions::from(scenario), progress)?)
+}
+
+/// One model's run of a scenario, measured.
+pub struct Assessed {
+    pub kind: ModelKind,
+    pub run: Run,
+    pub metrics: Metrics,
+    /// The static equilibrium at x2 and the closed-loop vertical mode there.
+    pub end: EndState,
+    /// The integrator that ran it.
+    pub integrator: IntegratorKind,
+}
+
+/// Simulates the scenario and measures it: metrics (§7) and the settled end state.
+pub fn assess(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Assessed, Error> {
+    let kind = ModelConfig::from_scenario(scenario)?.kind;
+    let run = simulate(scenario, progress)?;
+    Ok(Assessed {
+        kind,
+        metrics: metrics(scenario, &run),
+        end: end_state(scenario)?,
+        integrator: scenario.simulation.integrator,
+        run,
+    })
+}
+
+/// Metrics of a run of `scenario` (MODELS.md §7).
+pub fn metrics(scenario: &Scenario, run: &Run) -> Metrics {
+    Metrics::from_run(
+        run,
+        &Step5::from(&scenario.trajectory),
+        scenario.simulation.sample_period,
+    )
+}
+
+/// The static equilibrium at x2 and the closed-loop mode nearest eq. 15 there (the effector's
+/// vertical mode), from the finite-difference Jacobian of model + PID + tension distribution.
+pub fn end_state(scenario: &Scenario) -> Result<EndState, Error> {
+    let sys = ClosedLoop::new(build(scenario)?, scenario);
+    Ok(linearise::end_state(sys, eq15_at_end(scenario))?)
+}
+
+/// Eq. 15 at x2 with T = ΣT/2 [rad/s] (paper: 20.41 rad/s).
+pub fn eq15_at_end(scenario: &Scenario) -> f64 {
+    eq15_frequency(
+        0.5 * scenario.controller.tension_sum,
+        scenario.robot.effector_mass,
+        scenario.trajectory.x2,
+        scenario.robot.anchor_distance,
+    )
+}
+
+/// How the scenario's integrator renders an undamped mode of frequency `omega` [rad/s]: unchanged
+/// for DOPRI5 at its tolerance, the discrete frequency of generalised-α at the scenario's step and
+/// ρ∞ on the implicit path.
+pub fn mode_as_integrated(scenario: &Scenario, omega: f64) -> f64 {
+    let sim = &scenario.simulation;
+    match sim.integrator {
+        IntegratorKind::Dopri5 => omega,
+        IntegratorKind::Implicit => {
+            AlphaCoefficients::new(sim.rho_inf)
+                .discrete_mode(omega, sim.step)
+                .0
+        }
+    }
+}
+
+/// Modal analysis of the scenario's model at effector position `x` [m] (the static equilibrium
+/// of MODELS.md §2 there, with the reference held at x).
+pub fn analyse(scenario: &Scenario, x: f64, feedback: Loop) -> Result<Analysis, Error> {
+    Ok(linearise(scenario, x, feedback)?.analysis)
+}
+
+/// As [`analyse`], keeping the equilibrium state and the eigenvectors.
+pub fn linearise(scenario: &Scenario, x: f64, feedback: Loop) -> Result<Linearised, Error> {
+    struct Linearise<'a>(&'a Scenario, f64, Loop);
+    impl ModelVisitor for Linearise<'_> {
+        type Output = Result<Linearised, AnalysisError>;
+        fn visit<M: CableModel + Clone + Send + 'static>(self, model: M) -> Self::Output {
+            linearise::linearise(model, self.0, self.1, self.2)
+        }
+    }
+    Ok(with_model(scenario, Linearise(scenario, x, feedback))??)
+}
+
+/// The linearisation's resolution in growth rate at x [1/s]
+/// ([`cdpr_analysis::damping::growth_resolution`]).
+pub fn growth_resolution(scenario: &Scenario, x: f64) -> Result<f64, Error> {
+    damping::growth_resolution(scenario, x, &mut analyse)
+}
+
+/// The smallest axial damping in `range` [N s] that makes every closed-loop mode at x grow no
+/// faster than `threshold` [1/s] ([`cdpr_analysis::damping::damping_sweep`]).
+pub fn damping_sweep(
+    scenario: &Scenario,
+    x: f64,
+    range: (f64, f64),
+    scan: usize,
+    threshold: f64,
+) -> Result<Sweep, Error> {
+    damping::damping_sweep(scenario, x, range, scan, threshold, &mut analyse)
+}
