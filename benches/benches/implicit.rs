@@ -38,7 +38,7 @@ fn paper_runs(c: &mut Criterion) {
     group
         .sample_size(10)
         .measurement_time(Duration::from_secs(30));
-    for kind in [ModelKind::Lumped, ModelKind::Fe] {
+    for kind in ModelKind::MASSIVE {
         for (label, sample_period) in [("", 1e-5), ("_coarse_samples", 1e-4)] {
             let mut s = scenario(kind, None);
             s.simulation.sample_period = sample_period;
@@ -113,7 +113,7 @@ fn cost_vs_n(c: &mut Criterion) {
     group
         .sample_size(10)
         .measurement_time(Duration::from_secs(10));
-    for kind in [ModelKind::Lumped, ModelKind::Fe] {
+    for kind in ModelKind::MASSIVE {
         if std::env::var("CDPR_BENCH_ONLY").is_ok_and(|only| only != kind.name()) {
             continue;
         }

@@ -44,6 +44,34 @@ fn with_params<V: ParamsVisitor>(
 
 /// Builds the scenario's model (after the model's own checks of the scenario) and hands it to
 /// `visitor`.
+///
+/// # Examples
+///
+/// The number of state components of each model, computed on the concrete model types:
+///
+/// ```
+/// use cdpr_bench::core::model::CableModel;
+/// use cdpr_bench::core::scenario::Scenario;
+/// use cdpr_bench::{ModelKind, ModelVisitor, with_model};
+///
+/// struct StateLen;
+/// impl ModelVisitor for StateLen {
+///     type Output = usize;
+///     fn visit<M: CableModel + Clone + Send + 'static>(self, model: M) -> usize {
+///         model.state_len()
+///     }
+/// }
+///
+/// let mut scenario = Scenario::paper();
+/// let mut lengths = Vec::new();
+/// for kind in ModelKind::ALL {
+///     scenario.model = kind.into();
+///     lengths.push(with_model(&scenario, StateLen)?);
+/// }
+/// // Elastic: (x, z, ẋ, ż); lumped N = 40: 2 (4N + 2); FE N = 10: 2 (4(N − 1) + 6).
+/// assert_eq!(lengths, [4, 324, 84]);
+/// # Ok::<(), cdpr_bench::BuildError>(())
+/// ```
 pub fn with_model<V: ModelVisitor>(
     scenario: &Scenario,
     visitor: V,
@@ -66,6 +94,18 @@ pub fn with_model<V: ModelVisitor>(
 pub type DynModel = Box<dyn CableModel + Send>;
 
 /// The scenario's cable model.
+///
+/// # Examples
+///
+/// ```
+/// use cdpr_bench::core::scenario::Scenario;
+/// use cdpr_bench::{ModelConfig, ModelKind, build};
+///
+/// let mut scenario = Scenario::paper();
+/// scenario.model = ModelConfig { elements: Some(2), ..ModelConfig::of_kind(ModelKind::Lumped) }.into();
+/// let Err(err) = build(&scenario) else { panic!("two springs cannot make a lumped cable") };
+/// assert!(err.to_string().contains("model.elements"));
+/// ```
 pub fn build(scenario: &Scenario) -> Result<DynModel, BuildError> {
     struct Boxed;
     impl ModelVisitor for Boxed {

@@ -4,6 +4,18 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// A cable model of cdpr-bench (`[model] kind`, `--model`).
+///
+/// # Examples
+///
+/// ```
+/// use cdpr_bench::ModelKind;
+///
+/// let kind: ModelKind = "fe".parse()?;
+/// assert_eq!(kind, ModelKind::Fe);
+/// assert_eq!(ModelKind::ALL.map(ModelKind::name), ["elastic", "lumped", "fe"]);
+/// assert!("rigid".parse::<ModelKind>().unwrap_err().contains("allowed elastic, lumped, fe"));
+/// # Ok::<(), String>(())
+/// ```
 #[derive(
     Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default, Deserialize, Serialize,
 )]
@@ -22,6 +34,9 @@ pub enum ModelKind {
 impl ModelKind {
     /// Every model, in the order of the paper.
     pub const ALL: [ModelKind; 3] = [ModelKind::Elastic, ModelKind::Lumped, ModelKind::Fe];
+
+    /// The models whose cables have mass (and axial modes, pulley dynamics, an implicit path).
+    pub const MASSIVE: [ModelKind; 2] = [ModelKind::Lumped, ModelKind::Fe];
 
     /// The scenario file's spelling, also the model's name in files and tables.
     pub fn name(self) -> &'static str {

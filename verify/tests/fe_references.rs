@@ -35,7 +35,7 @@ fn error(end: [f64; 2], length: f64, ea: f64, n: usize) -> f64 {
 }
 
 /// Taut CDPR-like case: the linear elements reproduce the catenary's nodes to round-off,
-/// below 1e-9 m for N = 10…40 (the bound; MODELS.md FE.10.2: 1.5e-11–1.3e-11 m).
+/// below 1e-9 m for N = 10…40 (the required bound; MODELS.md FE.10.2: 1.5e-11–1.3e-11 m).
 #[test]
 fn taut_cable_is_the_catenary() {
     for n in [10, 20, 40] {

@@ -156,7 +156,7 @@ fn paper_iteration_matrices_keep_the_cheapest_layout() {
     use cdpr_bench::core::closed_loop::ClosedLoop;
     use cdpr_bench::numerics::SecondOrderSystem;
     use cdpr_bench::numerics::sparse::IterationMatrix;
-    for kind in [ModelKind::Lumped, ModelKind::Fe] {
+    for kind in ModelKind::MASSIVE {
         let scenario = paper(kind, IntegratorKind::Implicit);
         let mut sys = ClosedLoop::new(model(&scenario).unwrap(), &scenario);
         let (y, _) = sys.initial_state().unwrap();
@@ -208,7 +208,7 @@ const FINE_STEP: f64 = 2e-5;
 
 #[test]
 fn implicit_paper_runs_meet_section_8_and_track_dormand_prince() {
-    let kinds = [ModelKind::Lumped, ModelKind::Fe];
+    let kinds = ModelKind::MASSIVE;
     // Implicit paper runs (5 s) and the DP45 reference over the transition and the first
     // second of settling, all four side by side; and the lumped run at h = 2e-5 s for its
     // high-frequency row (below).

@@ -120,7 +120,7 @@ proptest! {
 
     /// Small transverse vibration of a taut lumped cable between fixed points (no gravity)
     /// against the discrete-chain formula ω_k = 2(N/l)√(T/μ_s)·sin(kπ/2N), μ_s the mass per
-    /// stretched length. Tolerance 1e-3 relative (the issue's); the stiffness matrix comes from
+    /// stretched length. Tolerance 1e-3 relative (required); the stiffness matrix comes from
     /// central differences of the chain's forces, so the agreement is ~1e-7.
     #[test]
     fn transverse_modes_match_the_discrete_string(
@@ -167,7 +167,7 @@ proptest! {
 /// (N = 10, rtol 1e-8): max |Δz| = 1.39e-4, 1.39e-5, 1.39e-6 m and max |Δx| = 1.83e-4,
 /// 1.83e-5 m at 1, 1/10, 1/100 of steel's density. So each tenfold reduction divides the
 /// difference by 10 (accepted 8–12); below 1/100, |Δx| stops at ~2e-6 m, a floor not set by the
-/// cable mass (noted in the issue), so the x ratio is taken over steel → 1/10.
+/// cable mass (a floor of its own), so the x ratio is taken over steel → 1/10.
 #[test]
 fn lumped_tends_to_elastic_as_density_vanishes() {
     let base = |kind: ModelKind, density: f64| {

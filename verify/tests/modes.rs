@@ -1,4 +1,4 @@
-//! Issue 7's tests of the modal analysis ([`cdpr_verify::modes`]): the elastic model's modes
+//! The modal analysis ([`cdpr_bench::analysis::modes`]): the elastic model's modes
 //! against the closed-form geometric stiffness (MODELS.md §3), the fixed-length lumped chain's
 //! transverse and axial modes against the discrete-chain formulas, the taut-string limit of the
 //! first string modes, and the growth rate of the lumped model's unstable axial mode
@@ -61,7 +61,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
     /// Random positions, tension sums and effector masses: the open-loop vertical and horizontal
     /// modes of the FD linearisation equal the closed-form geometric-stiffness frequencies to
-    /// 1e-6 relative (the issue's bound; the FD Jacobian of this smooth RHS is good to ~1e-9 and
+    /// 1e-6 relative (the required bound; the FD Jacobian of this smooth RHS is good to ~1e-9 and
     /// the 4×4 eigen-solve to round-off). §3's formula √(K_zz/M) ignores the x–z coupling K_xz,
     /// which vanishes only at the symmetric position: the FD mode must lie above it by no more
     /// than the closed form's coupling shift ω_z − √(K_zz/M) (+1e-6 relative).
@@ -130,7 +130,7 @@ proptest! {
     /// axial ones 2√(k0/m) sin(kπ/(2N)), k = 1 … N − 1. Every one of the 2(N − 1) FD modes,
     /// classified by the larger of its z (transverse) and x (axial) share, matches its formula to
     /// 1e-6 relative (the FD Jacobian of this piecewise-quadratic RHS is exact to ~1e-9 while the
-    /// stencil stays off the slack side; the issue's bound).
+    /// stencil stays off the slack side; the required bound).
     #[test]
     fn lumped_chain_modes_match_the_discrete_chain(
         elements in 3usize..30,
@@ -192,7 +192,7 @@ proptest! {
 /// compared as a set. Both loops, both massive models, both positions of the report.
 #[test]
 fn first_string_modes_near_the_taut_string() {
-    for kind in [ModelKind::Lumped, ModelKind::Fe] {
+    for kind in ModelKind::MASSIVE {
         let s = scenario(kind);
         for x in [0.5, 0.6] {
             for feedback in [Loop::Closed, Loop::Open] {
@@ -272,7 +272,7 @@ fn fine_lumped_mesh_keeps_the_axial_mode_converged() {
 /// forces and scattered these σ up to +2e-3 1/s (e.g. FE at C = 0.316 N s: +1.25e-3 1/s).
 #[test]
 fn damped_string_modes_do_not_grow() {
-    for kind in [ModelKind::Lumped, ModelKind::Fe] {
+    for kind in ModelKind::MASSIVE {
         for c in [7.5e-3, 3.16e-2, 0.1, 0.316, 1.0] {
             let mut s = scenario(kind);
             s.cable.axial_damping = c;
@@ -339,7 +339,7 @@ fn growing_modes_are_the_documented_ones() {
 /// is 1.4e-5 m), and the nonlinear model runs 1.5 s with DP45 (rtol 1e-5, atol 1e-9, the paper's).
 /// The envelope of the straddling-spring tension of the cable the mode lives in (max |T − mean| over
 /// 0.05 s windows, ~45 periods each) is fitted by least squares in log scale: its slope must match
-/// the linearised σ within 10 % (the issue's bound). DP45's own amplification at ωh ≈ 0.014 is
+/// the linearised σ within 10 % (the required bound). DP45's own amplification at ωh ≈ 0.014 is
 /// ~1e-11 per step, negligible; the window maximum is within cos(π/55) of the peak at 2e-5 s
 /// sampling. Measured: 0.5647 linearised vs 0.566 1/s measured (the ringing grows ~0.2 → 0.6 N). At 100× the
 /// amplitude (~18 N of ringing) the envelope grows at only 0.24 1/s: the mode saturates

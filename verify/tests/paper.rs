@@ -28,7 +28,7 @@ fn lumped_z_at_end(n: usize) -> f64 {
 
 #[test]
 fn paper_scenario_meets_every_section_8_row_with_every_model() {
-    let kinds = [ModelKind::Elastic, ModelKind::Lumped, ModelKind::Fe];
+    let kinds = ModelKind::ALL;
     let runs: Vec<Assessed> = std::thread::scope(|scope| {
         let handles: Vec<_> = kinds
             .iter()

@@ -1,5 +1,5 @@
 //! `cargo xtask modes`: every closed- and open-loop mode of the three models at given effector
-//! positions (issue 7), classified, as CSV and Markdown tables and a figure of the spectrum of modes
+//! positions, classified, as CSV and Markdown tables and a figure of the spectrum of modes
 //! (frequency vs damping ratio); and the axial-damping sweep: the smallest Kelvin–Voigt
 //! coefficient C (MODELS.md §4, FE.5.7) that makes every closed-loop mode of the lumped and FE
 //! models decay. The report (`cargo xtask report`) reuses [`ModesReport`] for its modes section.
@@ -49,7 +49,7 @@ pub fn compute(base: &Scenario, xs: &[f64], sweep_at: f64) -> Result<ModesReport
             }
         }
     }
-    let sweeps = [ModelKind::Lumped, ModelKind::Fe]
+    let sweeps = ModelKind::MASSIVE
         .into_iter()
         .map(|kind| {
             let s = cdpr_bench::with_model_kind(base, kind)?;
@@ -78,7 +78,7 @@ pub fn run(scenario: Option<&Path>, at: Option<f64>, out: &Path) -> Result<()> {
     let report = compute(&base, &xs, at.unwrap_or(base.trajectory.x2))?;
     report.write_files(out)?;
     write_atomic(&out.join("modes.md"), |w| {
-        writeln!(w, "# Modes of the three models (issue 7)\n")?;
+        writeln!(w, "# Modes of the three models\n")?;
         report.write_section(w, &[])
     })?;
     println!(

@@ -112,7 +112,7 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     let checks = acceptance::table(eq15, &views);
 
     let names = write_figures(&base, &outcomes, eq15, out)?;
-    // Issue 7: every model's modes at x1 and x2 and the axial-damping sweep (~1 s).
+    // Every model's modes at x1 and x2 and the axial-damping sweep (~1 s).
     let (x1, x2) = (base.trajectory.x1, base.trajectory.x2);
     let modes = crate::modes::compute(&base, &[x1, x2], x2)?;
     modes.write_files(out)?;
@@ -446,7 +446,7 @@ fn write_markdown(
             )?;
         }
 
-        writeln!(w, "\n## Modes of every model (issue 7)\n")?;
+        writeln!(w, "\n## Modes of every model\n")?;
         let peaks: Vec<(&str, f64, f64)> = outcomes
             .iter()
             .map(|o| {

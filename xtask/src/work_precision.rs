@@ -82,7 +82,7 @@ fn error(run: &Run, reference: &Run) -> Result<f64> {
 pub fn run_study(out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut points = Vec::new();
-    for model in [ModelKind::Lumped, ModelKind::Fe] {
+    for model in ModelKind::MASSIVE {
         eprintln!("{model}: reference (DOPRI5, rtol {REFERENCE_RTOL:e})");
         let mut reference_scenario = scenario(model, IntegratorKind::Dopri5, REFERENCE_RTOL)?;
         reference_scenario.simulation.atol = 1e-14;
@@ -141,7 +141,7 @@ pub fn run_study(out: &Path) -> Result<()> {
         y_label: "max |effector − reference| over [0, 0.25] s [m]".into(),
         log_x: true,
         log_y: true,
-        lines: [ModelKind::Lumped, ModelKind::Fe]
+        lines: ModelKind::MASSIVE
             .into_iter()
             .flat_map(|model| {
                 let points = &points;

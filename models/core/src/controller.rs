@@ -80,6 +80,25 @@ impl Pid {
     }
 }
 
+/// The closed-form split of two opposed cables' tensions (paper §3.2, MODELS.md §2): the
+/// tensions [T1, T2] = [(ΣT − F)/2, (ΣT + F)/2] [N] that sum to `tension_sum` ΣT and pull the
+/// effector toward A2 with the horizontal force `force` F [N]. The controller's distribution and
+/// every model's static equilibrium (with F = F0) use it.
+///
+/// # Examples
+///
+/// ```
+/// use cdpr_core::controller::split_tensions;
+///
+/// let [t1, t2] = split_tensions(200.0, 10.0);
+/// assert_eq!((t1, t2), (95.0, 105.0));
+/// assert_eq!(t1 + t2, 200.0);
+/// ```
+#[inline]
+pub fn split_tensions(tension_sum: f64, force: f64) -> [f64; 2] {
+    [0.5 * (tension_sum - force), 0.5 * (tension_sum + force)]
+}
+
 /// Closed-form tension distribution of two opposed cables (paper §3.2, Pott et al. 2009):
 /// T1 = (ΣT − F)/2, T2 = (ΣT + F)/2, F > 0 pulling toward A2; optional saturation to [t_min, t_max].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -106,11 +125,6 @@ impl TensionDistribution {
     /// Commanded tensions [T1, T2] [N] for the horizontal force F [N].
     #[inline]
     pub fn tensions(&self, force: f64) -> [f64; 2] {
-        let t1 = 0.5 * (self.tension_sum - force);
-        let t2 = 0.5 * (self.tension_sum + force);
-        [
-            t1.clamp(self.t_min, self.t_max),
-            t2.clamp(self.t_min, self.t_max),
-        ]
+        split_tensions(self.tension_sum, force).map(|t| t.clamp(self.t_min, self.t_max))
     }
 }

@@ -5,7 +5,7 @@
 use crate::channel::Channel;
 use crate::closed_loop::ClosedLoop;
 use crate::model::{CableModel, Equilibrium, ModelError, ModelEvent};
-use crate::scenario::{IntegratorKind, Scenario};
+use crate::scenario::{ImplicitMethod, IntegratorKind, Scenario};
 use crate::series::TimeSeries;
 use cdpr_numerics::{
     Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions, IntegratorError, SolverStats,
@@ -135,10 +135,12 @@ impl From<&Scenario> for RunOptions {
                 beta: sim.dopri_beta,
                 ..Dopri5Options::default()
             },
-            implicit: GeneralizedAlphaOptions {
-                step: sim.step,
-                rho_inf: sim.rho_inf,
-                ..GeneralizedAlphaOptions::default()
+            implicit: match sim.implicit_method {
+                ImplicitMethod::GeneralizedAlpha => GeneralizedAlphaOptions {
+                    step: sim.step,
+                    rho_inf: sim.rho_inf,
+                    ..GeneralizedAlphaOptions::default()
+                },
             },
         }
     }

@@ -4,6 +4,18 @@
 use crate::scenario;
 
 /// Quintic `step5` (paper eq. 13), with its first two derivatives for analysis and plots.
+///
+/// # Examples
+///
+/// ```
+/// use cdpr_core::trajectory::Step5;
+///
+/// let step = Step5 { x1: 0.5, x2: 0.6, t1: 0.0, t2: 0.2 };
+/// assert_eq!(step.position(0.0), 0.5);
+/// assert_eq!(step.position(0.2), 0.6);
+/// // Paper §3.1: v_max = 15 Δx / (8 T) = 0.9375 m/s at the middle of the move.
+/// assert!((step.velocity(0.1) - 0.9375).abs() < 1e-12);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Step5 {
     /// Start position x1 [m].
@@ -18,11 +30,13 @@ pub struct Step5 {
 
 impl From<&scenario::Trajectory> for Step5 {
     fn from(t: &scenario::Trajectory) -> Self {
-        Self {
-            x1: t.x1,
-            x2: t.x2,
-            t1: t.t1,
-            t2: t.t2,
+        match t.kind {
+            scenario::TrajectoryKind::Step5 => Self {
+                x1: t.x1,
+                x2: t.x2,
+                t1: t.t1,
+                t2: t.t2,
+            },
         }
     }
 }

@@ -6,6 +6,7 @@
 //!
 //! State: (x, z, ẋ, ż) of the effector [m, m/s].
 
+use cdpr_core::controller::split_tensions;
 use cdpr_core::modal_layout::{Dof, ModalLayout};
 use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError, ModelParams};
 use cdpr_core::scenario::{Scenario, ScenarioError};
@@ -131,10 +132,7 @@ impl StaticProblem for Eq14<'_> {
         1
     }
     fn residual(&mut self, u: &[f64], r: &mut [f64]) {
-        let tensions = [
-            0.5 * (self.tension_sum - u[1]),
-            0.5 * (self.tension_sum + u[1]),
-        ];
+        let tensions = split_tensions(self.tension_sum, u[1]);
         let f = self.model.net_force(Vector2::new(self.x, u[0]), tensions);
         r[0] = f.x;
         r[1] = f.y;

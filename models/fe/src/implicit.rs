@@ -332,7 +332,7 @@ impl SecondOrderForm for Fe {
     /// tensions. Why not M q'' from the assembled system: scattering M into the block form,
     /// clearing it and multiplying it out again is a second pass over every node that the
     /// residual does not need (FE implicit paper run 0.1436 → 0.1420 s). The rows collected
-    /// before they are summed and the lanes took it from 0.124 to 0.097 s (README).
+    /// before they are summed and the lanes took it from 0.124 to 0.097 s (docs/performance.md).
     fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]) {
         let (n, nn, np) = (self.elements, self.chain_nodes(), self.positions_len());
         r.fill(0.0);

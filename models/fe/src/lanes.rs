@@ -13,7 +13,7 @@
 //!
 //! Why: a span element's ~100 operations spill registers one element at a time, and one element
 //! after another waits on its chord's square root and division; four elements in lanes use the
-//! vector width the scalar code leaves idle (FE implicit paper run: see the README's table).
+//! vector width the scalar code leaves idle (FE implicit paper run: docs/performance.md).
 
 use crate::Span;
 use crate::element::{self, Chord, ElementState, MassCoefficients, Material};

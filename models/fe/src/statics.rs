@@ -7,6 +7,7 @@
 //! continuous, so the solution is the discrete version of the continuum CDPR of FE.8.3.
 
 use crate::Fe;
+use cdpr_core::controller::split_tensions;
 use cdpr_core::model::{CableModel, Equilibrium, ModelError};
 use cdpr_core::second_order::SecondOrderForm;
 use cdpr_core::statics;
@@ -35,10 +36,7 @@ struct Problem<'a> {
 
 impl Problem<'_> {
     fn tensions(&self, force: f64) -> [f64; 2] {
-        [
-            0.5 * (self.tension_sum - force),
-            0.5 * (self.tension_sum + force),
-        ]
+        split_tensions(self.tension_sum, force)
     }
 
     fn load(&mut self, u: &[f64]) {

@@ -95,7 +95,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 
     /// FE.11.1: M_ii = 2T(q, e_i), M_ij = T(e_i + e_j) − T(e_i) − T(e_j). Per entry relative to
-    /// √(M_ii M_jj) (the Cauchy–Schwarz bound of an SPD entry): 1e-12, the bound; the
+    /// √(M_ii M_jj) (the Cauchy–Schwarz bound of an SPD entry): 1e-12, the required bound; the
     /// differences of T values ~1 J carry ~1e-16 J of round-off against entries ≥ 1e-4 kg.
     #[test]
     fn mass_matrix_is_the_hessian_of_the_kinetic_energy(
@@ -127,7 +127,7 @@ proptest! {
     }
 
     /// FE.11.2: the assembled F against central differences of the Lagrangian. Relative to
-    /// max |F| (the 100 N tensions) 1e-6, the bound; and the velocity-dependent part alone
+    /// max |F| (the 100 N tensions) 1e-6, the required bound; and the velocity-dependent part alone
     /// (F(q, q') − F(q, 0), 1e-3–1 N) to 1e-5 of its own size, so the small inertial terms are
     /// tested too (measured: 6e-9 and up to 1e-7 of the respective sizes).
     #[test]
@@ -167,7 +167,7 @@ proptest! {
 
     /// FE.11.3: the model's kinetic energy equals ½∫μ|v|² of the material velocity, v from
     /// central time differences (δ = 1e-7 s) of positions at fixed material labels σ, 2-point
-    /// Gauss per element (exact for the ansatz). 1e-6 relative, the bound: the time
+    /// Gauss per element (exact for the ansatz). 1e-6 relative, the required bound: the time
     /// difference is O(δ²) ≈ 1e-14 exact and ~1e-9 in round-off. A wrong (1 − ξ) term fails by
     /// O(1).
     #[test]
@@ -270,7 +270,7 @@ fn material_kinetic(m: &Fe, y: &[f64], dt: f64) -> f64 {
 
 /// FE.11.4: with l' = 0 the r-rows are the standard truss: consistent mass μh/6 [[2,1],[1,2]]
 /// per element (effector M), force N t and lumped gravity μ g h/2 per end node. Absolute 1e-9
-/// (kg, N), the bound; the two are the same sums in a different order (~1e-13).
+/// (kg, N), the required bound; the two are the same sums in a different order (~1e-13).
 #[test]
 fn zero_pay_out_is_the_standard_truss() {
     for seed in 0..8u64 {
@@ -333,7 +333,7 @@ fn zero_pay_out_is_the_standard_truss() {
 
 /// FE.11.5: g = 0, straight cables at T1 = T2 = 100 N, the whole cable translating at u = 0.7 m/s
 /// (cable 1 paying out, cable 2 reeling in) is an exact steady state of the elastic-stored model:
-/// |q''| < 1e-4 m/s² (the bound; MODELS.md measured 1.7e-6, round-off of EA/h·ulp over
+/// |q''| < 1e-4 m/s² (the required bound; MODELS.md measured 1.7e-6, round-off of EA/h·ulp over
 /// node masses of 7e-4 kg). The rigid stored cable has the strain-jump defect: ≈ 6e-4 m/s².
 #[test]
 fn steady_pay_out_is_a_steady_state() {

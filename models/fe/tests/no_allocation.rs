@@ -1,31 +1,14 @@
-//! The FE right-hand side must not allocate (issue: "the RHS evaluation must not allocate"): a
-//! counting global allocator, in its own test binary, watches 1000 evaluations of the model and of
-//! the closed loop around it.
+//! The FE right-hand side must not allocate: a counting global allocator, in its own test binary,
+//! watches 1000 evaluations of the model and of the closed loop around it.
 
 use cdpr_core::closed_loop::ClosedLoop;
 use cdpr_core::model::CableModel;
 use cdpr_core::scenario::Scenario;
 use cdpr_fe::{Fe, Params};
 use cdpr_numerics::OdeSystem;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: cdpr_testing::CountingAllocator = cdpr_testing::CountingAllocator;
 
 #[test]
 fn rhs_does_not_allocate() {
@@ -37,13 +20,13 @@ fn rhs_does_not_allocate() {
     let (y, _) = sys.initial_state().unwrap();
     let mut dy = vec![0.0; y.len()];
     let mut check = 0.0;
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = cdpr_testing::allocations();
     for k in 0..1000 {
         model.rhs(k as f64 * 1e-6, &eq.state, [100.0, 100.0], &mut rate);
         sys.rhs(k as f64 * 1e-4, &y, &mut dy);
         check += model.reel_speeds(&eq.state)[0] + rate[0] + dy[0];
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = cdpr_testing::allocations();
     assert_eq!(after - before, 0, "allocations in 1000 RHS evaluations");
     assert!(check.is_finite());
 }

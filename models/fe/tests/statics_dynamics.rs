@@ -20,7 +20,7 @@ fn paper_model() -> Fe {
 
 /// FE.11.7 (statics): at x = 0.5 with T1 = T2 the equilibrium is symmetric: F0 = 0 (< 1e-9 N)
 /// and node k of cable 2 is node k of cable 1 mirrored in x = d/2 (< 1e-12 m). Both are the
-/// issue's bounds; Newton's last update is below 1e-12 m.
+/// required bounds; Newton's last update is below 1e-12 m.
 #[test]
 fn symmetric_start_is_symmetric() {
     let mut m = paper_model();
@@ -39,7 +39,7 @@ fn symmetric_start_is_symmetric() {
 }
 
 /// FE.11.7 (dynamics): the closed loop with x_ref ≡ 0.5 from that equilibrium stays there:
-/// |x − 0.5| and the drift of z below 1e-12 m over 0.5 s (the bound).
+/// |x − 0.5| and the drift of z below 1e-12 m over 0.5 s (the required bound).
 #[test]
 fn equilibrium_is_preserved() {
     let mut scenario = Scenario::paper();
@@ -60,7 +60,7 @@ fn equilibrium_is_preserved() {
 
 /// FE.11.9: the FE equilibrium (N = 10, elastic stored cable) against MODELS.md FE.8.3's
 /// continuum catenary table (z_P, l_1, l_2 printed to 1e-9 m, F0 to 1e-6 N): |δz|, |δl| < 1e-8 m
-/// and |δF0| < 1e-5 N (the bounds, 10× the printed rounding). The element tensions N_1,
+/// and |δF0| < 1e-5 N (the required bounds, 10× the printed rounding). The element tensions N_1,
 /// N_N, printed to 1e-6 N, within 1e-6 N.
 #[test]
 fn cdpr_statics_match_the_continuum() {
@@ -123,7 +123,7 @@ fn cdpr_statics_match_the_continuum() {
 
 /// FE.11.10: prescribed tensions T1 = 100 + 10 sin 6πt, T2 = 100 + 10 sin(6πt + 0.5) + 3 sin 14πt
 /// from the x = 0.5 equilibrium, 0.5 s of DOPRI5: max |E − E0 − W| below 1e-7 J at rtol 1e-5
-/// (atol 1e-8) and below 1e-8 J at rtol 1e-8 (atol 1e-11), the bounds (MODELS.md
+/// (atol 1e-8) and below 1e-8 J at rtol 1e-8 (atol 1e-11), the required bounds (MODELS.md
 /// FE.10.3 measured 5.0e-9 and 1.5e-10 J); the reels did ~0.58 J of work.
 #[test]
 fn energy_identity_with_prescribed_tensions() {
@@ -173,7 +173,7 @@ fn open_loop_frequencies(m: &mut Fe, y: &[f64], tensions: [f64; 2]) -> Vec<f64> 
 
 /// FE.11.11 (open loop, constant tensions): vertical mode 19.917 (x = 0.5) and 20.328 rad/s
 /// (x = 0.6) ±0.005, first string modes 536.24/536.99 rad/s at x = 0.5 ±0.5, largest frequency
-/// 2.409e5 (x = 0.5) and 3.008e5 rad/s (x = 0.6) ±0.5 % (the bounds; the FD stiffness is
+/// 2.409e5 (x = 0.5) and 3.008e5 rad/s (x = 0.6) ±0.5 % (the required bounds; the FD stiffness is
 /// good to ~1e-6 relative).
 #[test]
 fn linearised_frequencies_match_models_md() {

@@ -15,6 +15,7 @@
 
 use crate::pulley::beyond;
 use crate::{E_OUT, Lumped};
+use cdpr_core::controller::split_tensions;
 use cdpr_core::model::{CableModel, Equilibrium, ModelError};
 use cdpr_core::second_order::SecondOrderForm;
 use cdpr_core::statics;
@@ -92,10 +93,7 @@ impl Problem {
     }
 
     fn tensions(&self, force: f64) -> [f64; 2] {
-        [
-            0.5 * (self.tension_sum - force),
-            0.5 * (self.tension_sum + force),
-        ]
+        split_tensions(self.tension_sum, force)
     }
 
     fn load(&mut self, u: &[f64]) {

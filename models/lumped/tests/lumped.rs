@@ -133,7 +133,7 @@ proptest! {
 /// The paper's method: add damping, hold the effector's x, let the cable settle. Mass-
 /// proportional damping c = 40 1/s decays every mode at ≥ 20 1/s (the vertical mode, 20 rad/s,
 /// is critically damped), so after 1 s a 1e-5 m disturbance is below 1e-13 m: Newton and
-/// relaxation must agree to 1e-9 m (MODELS.md §4, the bound).
+/// relaxation must agree to 1e-9 m (MODELS.md §4, the required bound).
 struct Relaxation {
     model: Lumped,
     tensions: [f64; 2],

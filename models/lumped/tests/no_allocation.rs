@@ -1,28 +1,12 @@
-//! The lumped right-hand side must not allocate (issue: "the RHS evaluation must not allocate"):
-//! a counting global allocator, in its own test binary, watches 1000 evaluations.
+//! The lumped right-hand side must not allocate: a counting global allocator, in its own test
+//! binary, watches 1000 evaluations.
 
 use cdpr_core::model::CableModel;
 use cdpr_core::scenario::Scenario;
 use cdpr_lumped::{Lumped, Params};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: cdpr_testing::CountingAllocator = cdpr_testing::CountingAllocator;
 
 #[test]
 fn rhs_does_not_allocate() {
@@ -31,13 +15,13 @@ fn rhs_does_not_allocate() {
     let eq = model.equilibrium(0.5, 200.0).unwrap();
     let mut rate = vec![0.0; model.state_len()];
     let mut energy = 0.0;
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = cdpr_testing::allocations();
     for k in 0..1000 {
         model.rhs(k as f64 * 1e-6, &eq.state, [100.0, 100.0], &mut rate);
         model.event_functions(&eq.state, &mut [0.0; 6]);
         energy += model.reel_speeds(&eq.state)[0];
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = cdpr_testing::allocations();
     assert_eq!(after - before, 0, "allocations in 1000 RHS evaluations");
     assert!(energy.is_finite());
 }
