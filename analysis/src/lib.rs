@@ -30,4 +30,9 @@ pub enum AnalysisError {
     Modal(#[from] ModalError),
     #[error("no oscillatory closed-loop mode found")]
     NoMode,
+    /// The dense eigen-analysis would cost more than it is allowed (time O(n³), memory O(n²)).
+    #[error(
+        "the linearised loop has {states} states, more than the dense eigen-analysis's limit of {limit} (lumped N ≤ 249, FE N ≤ 499)"
+    )]
+    TooLarge { states: usize, limit: usize },
 }

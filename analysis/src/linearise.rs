@@ -49,6 +49,7 @@ pub fn linearise<M: CableModel>(
     feedback: Loop,
 ) -> Result<Linearised, AnalysisError> {
     let mut sys = ClosedLoop::new(model, scenario);
+    check_size(sys.model_len() + 2)?;
     // Hold the reference at x: the loop is then autonomous and x is its equilibrium.
     sys.trajectory = Step5 {
         x1: x,
@@ -122,6 +123,23 @@ pub fn linearise<M: CableModel>(
     })
 }
 
+/// Largest linearised loop (model states + the two controller states) whose modes are computed:
+/// the dense finite-difference Jacobian and eigen-decomposition cost O(n) right-hand sides, O(n²)
+/// memory and O(n³) time (about 4 s and 0.1 GB at the limit on this 2-core machine; a lumped
+/// N = 1000 loop, 8 004 states, would take minutes and 1.5 GB, N = 10 000 51 GB).
+pub const DENSE_MAX_STATES: usize = 2000;
+
+/// Refuses a loop of `states` states above [`DENSE_MAX_STATES`].
+fn check_size(states: usize) -> Result<(), AnalysisError> {
+    if states > DENSE_MAX_STATES {
+        return Err(AnalysisError::TooLarge {
+            states,
+            limit: DENSE_MAX_STATES,
+        });
+    }
+    Ok(())
+}
+
 /// The settled end of the move: the static equilibrium at x2 and the closed-loop mode there.
 #[derive(Debug, Clone)]
 pub struct EndState {
@@ -139,6 +157,7 @@ pub fn end_state<M: CableModel>(
     mut sys: ClosedLoop<M>,
     omega_guess: f64,
 ) -> Result<EndState, AnalysisError> {
+    check_size(sys.model_len() + 2)?;
     let (y, eq) = sys.rest_state(sys.trajectory.x2)?;
     // After t2 the reference is constant: the loop is autonomous there.
     let t = sys.trajectory.t2 + 1.0;

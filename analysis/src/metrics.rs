@@ -97,6 +97,53 @@ pub struct Metrics {
     pub wall_s: f64,
 }
 
+/// The unit of every key of [`Metrics`] as `metrics.json` writes it ("" for counts and names;
+/// `err_hf_peaks` holds [rad/s, dB] pairs).
+pub const UNITS: &[(&str, &str)] = &[
+    ("model", ""),
+    ("t1_min", "N"),
+    ("t1_min_time", "s"),
+    ("t1_max", "N"),
+    ("t1_max_time", "s"),
+    ("t2_min", "N"),
+    ("t2_min_time", "s"),
+    ("t2_max", "N"),
+    ("t2_max_time", "s"),
+    ("t1_final", "N"),
+    ("t2_final", "N"),
+    ("t1_mean_4_5", "N"),
+    ("t2_mean_4_5", "N"),
+    ("err_max_transition", "m"),
+    ("err_max_after_1s", "m"),
+    ("err_max_after_1_5s", "m"),
+    ("overshoot", "m"),
+    ("z_mean", "m"),
+    ("z_p2p", "m"),
+    ("z_peak_rad_s", "rad/s"),
+    ("err_peak_rad_s", "rad/s"),
+    ("z_plain_peak_rad_s", "rad/s"),
+    ("err_plain_peak_rad_s", "rad/s"),
+    ("z_fft_0_5_bin_rad_s", "rad/s"),
+    ("z_fft_0_5_bin", ""),
+    ("err_hf_peak_rad_s", "rad/s"),
+    ("err_hf_peak_db", "dB"),
+    ("err_hf_peaks", "[rad/s, dB]"),
+    ("z0", "m"),
+    ("f0", "N"),
+    ("energy_residual_max", "J"),
+    ("pulley_events", ""),
+    ("pulley_energy_loss", "J"),
+    ("pulley_chatter", ""),
+    ("rhs_evals", ""),
+    ("steps_accepted", ""),
+    ("steps_rejected", ""),
+    ("newton_iterations", ""),
+    ("jacobian_evals", ""),
+    ("factorisations", ""),
+    ("pivotings", ""),
+    ("wall_s", "s"),
+];
+
 /// Index range of the samples with t in [a, b] (`include_end`) or [a, b), on a grid of period dt.
 fn window(t: &[f64], a: f64, b: f64, include_end: bool, dt: f64) -> std::ops::Range<usize> {
     let half = 0.5 * dt;

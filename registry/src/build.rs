@@ -36,7 +36,7 @@ fn with_params<V: ParamsVisitor>(
     visitor: V,
 ) -> Result<V::Output, ScenarioError> {
     Ok(match config.kind {
-        ModelKind::Elastic => visitor.visit(cdpr_elastic::Params),
+        ModelKind::Elastic => visitor.visit(cdpr_elastic::Params {}),
         ModelKind::Lumped => visitor.visit(config.lumped()?),
         ModelKind::Fe => visitor.visit(config.fe()?),
     })
@@ -88,6 +88,22 @@ pub fn with_model<V: ModelVisitor>(
         &ModelConfig::from_scenario(scenario)?,
         Build(scenario, visitor),
     )?
+}
+
+/// The `[model]` section as the chosen model reads it: its kind and its own keys, defaults filled.
+pub(crate) fn resolved_section(config: &ModelConfig) -> Result<serde_json::Value, ScenarioError> {
+    struct Resolve(ModelKind);
+    impl ParamsVisitor for Resolve {
+        type Output = Result<serde_json::Value, ScenarioError>;
+        fn visit<P: ModelParams>(self, params: P) -> Self::Output {
+            let mut section = serde_json::to_value(&params).map_err(|e| {
+                ScenarioError::Syntax(format!("[model] of {} not serialisable: {e}", self.0))
+            })?;
+            section["kind"] = serde_json::Value::from(self.0.name());
+            Ok(section)
+        }
+    }
+    with_params(config, Resolve(config.kind))?
 }
 
 /// A cable model, whichever the scenario names: what the closed loop runs.

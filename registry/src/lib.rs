@@ -28,7 +28,8 @@
 //! // The paper's T1 minimum during the move: 92 N (MODELS.md §8).
 //! assert!((outcome.metrics.t1_min - 92.0).abs() < 1.0);
 //! // The closed-loop vertical mode at x2, next to eq. 15's 20.41 rad/s.
-//! assert!((outcome.end.mode.omega - 20.37).abs() < 0.01);
+//! let end = outcome.end.state().expect("the elastic loop is small");
+//! assert!((end.mode.omega - 20.37).abs() < 0.01);
 //!
 //! let series = &outcome.run.series;
 //! let x = series.column(Channel::X).expect("every run has x");
@@ -40,6 +41,7 @@
 mod build;
 mod config;
 mod kind;
+mod provenance;
 mod study;
 
 pub use build::{BuildError, DynModel, ModelVisitor, build, with_model};
@@ -47,9 +49,11 @@ pub use config::{
     ModelConfig, scenario_from_file, scenario_from_toml_str, validate, with_model_kind,
 };
 pub use kind::ModelKind;
+pub use provenance::{Provenance, revision};
 pub use study::{
-    Assessed, Error, analyse, assess, damping_sweep, end_state, eq15_at_end, growth_resolution,
-    linearise, metrics, mode_as_integrated, simulate,
+    Assessed, EndAnalysis, Error, analyse, assess, assess_observed, damping_sweep, end_analysis,
+    end_state, eq15_at_end, growth_resolution, linearise, metrics, mode_as_integrated, simulate,
+    simulate_observed,
 };
 
 /// The crates this one composes, for their types.

@@ -12,8 +12,10 @@ use cdpr_analysis::metrics::Metrics;
 use cdpr_analysis::modes::{Analysis, Loop};
 use cdpr_core::closed_loop::ClosedLoop;
 use cdpr_core::model::{CableModel, ModelError};
-use cdpr_core::runner::{Run, RunFailure, RunOptions, simulate as run_loop};
-use cdpr_core::scenario::{IntegratorKind, Scenario, ScenarioError};
+use cdpr_core::runner::{
+    Observer, Run, RunFailure, RunOptions, simulate as run_loop, simulate_observed as simulate_run,
+};
+use cdpr_core::scenario::{IntegratorKind, ModesChoice, Scenario, ScenarioError};
 use cdpr_core::trajectory::Step5;
 use cdpr_elastic::eq15_frequency;
 use cdpr_numerics::AlphaCoefficients;
@@ -40,6 +42,16 @@ impl From<BuildError> for Error {
     }
 }
 
+/// As [`simulate`], watched and steered by `observer` (progress, each sample, a stop flag).
+pub fn simulate_observed(scenario: &Scenario, observer: &mut Observer) -> Result<Run, Error> {
+    let mut sys = ClosedLoop::new(build(scenario)?, scenario);
+    Ok(simulate_run(
+        &mut sys,
+        &RunOptions::from(scenario),
+        observer,
+    )?)
+}
+
 /// Simulates the scenario: the MODELS.md §2 initial state, then the scenario's integrator,
 /// sampled every sample period. `progress` receives the fraction of time done.
 pub fn simulate(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Run, Error> {
@@ -52,23 +64,115 @@ pub struct Assessed {
     pub kind: ModelKind,
     pub run: Run,
     pub metrics: Metrics,
-    /// The static equilibrium at x2 and the closed-loop vertical mode there.
-    pub end: EndState,
+    /// The static equilibrium at x2 and the closed-loop vertical mode there, as far as that
+    /// analysis went.
+    pub end: EndAnalysis,
     /// The integrator that ran it.
     pub integrator: IntegratorKind,
 }
 
-/// Simulates the scenario and measures it: metrics (§7) and the settled end state.
+/// The modal analysis at the end of the move, which never costs a run its results: done,
+/// skipped (by choice or by size) or failed, with the reason.
+#[derive(Debug, Clone)]
+pub enum EndAnalysis {
+    Done(EndState),
+    /// Not attempted: `[analysis] modes = "off"`, or the loop is larger than the dense
+    /// eigen-analysis's limit.
+    Skipped {
+        reason: String,
+    },
+    /// Attempted and failed (e.g. no equilibrium at x2).
+    Failed {
+        reason: String,
+    },
+}
+
+impl EndAnalysis {
+    /// The end state, where the analysis was done.
+    pub fn state(&self) -> Option<&EndState> {
+        match self {
+            EndAnalysis::Done(end) => Some(end),
+            _ => None,
+        }
+    }
+
+    /// "done", "skipped" or "failed".
+    pub fn status(&self) -> &'static str {
+        match self {
+            EndAnalysis::Done(_) => "done",
+            EndAnalysis::Skipped { .. } => "skipped",
+            EndAnalysis::Failed { .. } => "failed",
+        }
+    }
+
+    /// Why it was skipped or failed.
+    pub fn reason(&self) -> Option<&str> {
+        match self {
+            EndAnalysis::Done(_) => None,
+            EndAnalysis::Skipped { reason } | EndAnalysis::Failed { reason } => Some(reason),
+        }
+    }
+}
+
+/// Simulates the scenario and measures it: metrics (§7) and, as `[analysis] modes` chooses, the
+/// settled end state, whose failure is reported, never fatal.
 pub fn assess(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Assessed, Error> {
     let kind = ModelConfig::from_scenario(scenario)?.kind;
     let run = simulate(scenario, progress)?;
     Ok(Assessed {
         kind,
         metrics: metrics(scenario, &run),
-        end: end_state(scenario)?,
+        end: end_analysis(scenario),
         integrator: scenario.simulation.integrator,
         run,
     })
+}
+
+/// As [`assess`], watched and steered by `observer`.
+pub fn assess_observed(scenario: &Scenario, observer: &mut Observer) -> Result<Assessed, Error> {
+    let kind = ModelConfig::from_scenario(scenario)?.kind;
+    let run = simulate_observed(scenario, observer)?;
+    Ok(Assessed {
+        kind,
+        metrics: metrics(scenario, &run),
+        end: end_analysis(scenario),
+        integrator: scenario.simulation.integrator,
+        run,
+    })
+}
+
+impl Assessed {
+    /// What can be measured of a run that stopped early: its metrics over the samples taken; the
+    /// end's modal analysis is skipped.
+    pub fn partial(scenario: &Scenario, kind: ModelKind, run: Run) -> Self {
+        Self {
+            kind,
+            metrics: metrics(scenario, &run),
+            end: EndAnalysis::Skipped {
+                reason: format!("the run stopped at t = {} s", run.t_reached),
+            },
+            integrator: scenario.simulation.integrator,
+            run,
+        }
+    }
+}
+
+/// The end state as `[analysis] modes` chooses, its size limit and failure turned into notes.
+pub fn end_analysis(scenario: &Scenario) -> EndAnalysis {
+    if scenario.analysis.modes == ModesChoice::Off {
+        return EndAnalysis::Skipped {
+            reason: "[analysis] modes = \"off\"".into(),
+        };
+    }
+    match end_state(scenario) {
+        Ok(end) => EndAnalysis::Done(end),
+        Err(Error::Analysis(e @ AnalysisError::TooLarge { .. })) => EndAnalysis::Skipped {
+            reason: e.to_string(),
+        },
+        Err(e) => EndAnalysis::Failed {
+            reason: e.to_string(),
+        },
+    }
 }
 
 /// Metrics of a run of `scenario` (MODELS.md §7).

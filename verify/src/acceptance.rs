@@ -47,7 +47,8 @@ impl<'a> ModelResult<'a> {
         Self {
             kind: outcome.kind,
             metrics: &outcome.metrics,
-            vertical_mode: outcome.end.mode.omega,
+            // Without the end's modal analysis the rows that compare with it fail.
+            vertical_mode: outcome.end.state().map_or(f64::NAN, |end| end.mode.omega),
             axial_mode,
             integrator: outcome.integrator,
         }

@@ -53,7 +53,7 @@ fn paper_scenario_meets_every_section_8_row_with_every_model() {
     // MODELS.md §7: closed-loop vertical modes 20.3738 / 20.329 / 20.326 rad/s (±0.001: their
     // rounding plus our finite-difference Jacobian's ~1e-8 relative error).
     for (run, reference) in [(elastic, 20.3738), (lumped, 20.329), (fe, 20.326)] {
-        let mode = run.end.mode;
+        let mode = run.end.state().unwrap().mode;
         assert!(
             (mode.omega - reference).abs() < 1e-3,
             "{}: {mode:?}",
@@ -108,7 +108,7 @@ fn paper_scenario_meets_every_section_8_row_with_every_model() {
     );
     let continuum = z80 + (z80 - z40) / (2f64.powf(order) - 1.0);
     let discretisation = (z40 - continuum).abs();
-    let fe_static = fe.end.effector.y;
+    let fe_static = fe.end.state().unwrap().effector.y;
     assert!(
         (fe_static - continuum).abs() < 0.05 * discretisation,
         "FE {fe_static} vs {continuum}"

@@ -2,7 +2,6 @@
 //! sees half a file and an interrupted run never leaves one; and the progress bar.
 
 use anyhow::{Context, Result};
-use cdpr_bench::core::series::TimeSeries;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::{BufWriter, IsTerminal, Write};
 use std::path::Path;
@@ -30,24 +29,17 @@ pub fn write_atomic(
     std::fs::rename(&tmp, path).with_context(|| format!("renaming into {}", path.display()))
 }
 
-/// The series as CSV: a header row, then every `every`-th sample; floats in Rust's shortest
-/// round-trip form, so the file is bit-reproducible and loses nothing.
-pub fn write_csv(path: &Path, series: &TimeSeries, every: usize) -> Result<()> {
-    write_atomic(path, |w| {
-        writeln!(w, "{}", series.names().join(","))?;
-        for i in (0..series.len()).step_by(every.max(1)) {
-            let mut first = true;
-            for v in series.row(i) {
-                if !first {
-                    w.write_all(b",")?;
-                }
-                first = false;
-                write!(w, "{v}")?;
-            }
-            w.write_all(b"\n")?;
+/// One CSV row of `values` appended to `line`: floats in Rust's shortest round-trip form, so the
+/// file is bit-reproducible and loses nothing.
+pub fn csv_row(line: &mut String, values: &[f64]) {
+    use std::fmt::Write as _;
+    for (k, v) in values.iter().enumerate() {
+        if k > 0 {
+            line.push(',');
         }
-        Ok(())
-    })
+        let _ = write!(line, "{v}");
+    }
+    line.push('\n');
 }
 
 /// Pretty JSON of `value`, newline-terminated.
@@ -58,19 +50,58 @@ pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
     })
 }
 
-/// A progress bar on a terminal, hidden otherwise (CI logs stay clean).
-pub fn progress_bar(label: &str) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
+/// Progress of a long run: a bar on a terminal; elsewhere (CI logs, batch jobs) a plain line at
+/// every tenth of the work, so a log shows how far a run got.
+pub struct Progress {
+    label: String,
+    bar: Option<ProgressBar>,
+    start: std::time::Instant,
+    next_tenth: u32,
+}
+
+impl Progress {
+    pub fn new(label: &str) -> Self {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let bar = ProgressBar::new(1000);
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "{prefix:>8} [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}",
+                )
+                .expect("static template")
+                .progress_chars("=> "),
+            );
+            bar.set_prefix(label.to_owned());
+            bar
+        });
+        Self {
+            label: label.to_owned(),
+            bar,
+            start: std::time::Instant::now(),
+            next_tenth: 1,
+        }
     }
-    let bar = ProgressBar::new(1000);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{prefix:>8} [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}",
-        )
-        .expect("static template")
-        .progress_chars("=> "),
-    );
-    bar.set_prefix(label.to_owned());
-    bar
+
+    /// The fraction `done` of the work is done.
+    pub fn set(&mut self, done: f64) {
+        match &self.bar {
+            Some(bar) => bar.set_position((done * 1000.0) as u64),
+            None => {
+                while self.next_tenth <= 10 && done >= f64::from(self.next_tenth) / 10.0 {
+                    eprintln!(
+                        "{}: {} % after {:.1} s",
+                        self.label,
+                        10 * self.next_tenth,
+                        self.start.elapsed().as_secs_f64()
+                    );
+                    self.next_tenth += 1;
+                }
+            }
+        }
+    }
+
+    pub fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
 }

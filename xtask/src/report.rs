@@ -10,6 +10,7 @@ use crate::simulate::load_scenario;
 use anyhow::{Result, bail};
 use cdpr_bench::Assessed as Outcome;
 use cdpr_bench::ModelKind;
+use cdpr_bench::analysis::linearise::EndState;
 use cdpr_bench::analysis::metrics::Metrics;
 use cdpr_bench::core::channel::Channel;
 use cdpr_bench::core::runner::Run;
@@ -102,6 +103,20 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
             .collect()
     });
     let outcomes = results.into_iter().collect::<Result<Vec<Outcome>>>()?;
+    // The report compares every model's end state: without it there is no report.
+    let ends = outcomes
+        .iter()
+        .map(|o| {
+            o.end.state().cloned().ok_or_else(|| {
+                anyhow::anyhow!(
+                    "{} model: the modal analysis at x2 {}: {}",
+                    o.kind,
+                    o.end.status(),
+                    o.end.reason().unwrap_or_default()
+                )
+            })
+        })
+        .collect::<Result<Vec<EndState>>>()?;
 
     let eq15 = cdpr_bench::eq15_at_end(&base);
     let axial_mode = cdpr_bench::mode_as_integrated(&base, acceptance::LUMPED_AXIAL_MODE);
@@ -122,17 +137,18 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
             eq15_rad_s: eq15,
             models: outcomes
                 .iter()
-                .map(|o| ModelEntry {
+                .zip(&ends)
+                .map(|(o, end)| ModelEntry {
                     metrics: &o.metrics,
-                    vertical_mode: o.end.mode,
-                    x2_effector_z: o.end.effector.y,
-                    x2_force: o.end.equilibrium.force,
+                    vertical_mode: end.mode,
+                    x2_effector_z: end.effector.y,
+                    x2_force: end.equilibrium.force,
                 })
                 .collect(),
             checks: &checks,
         },
     )?;
-    write_markdown(&base, &outcomes, &checks, eq15, &names, &modes, out)?;
+    write_markdown(&base, &outcomes, &ends, &checks, eq15, &names, &modes, out)?;
     let failed = checks.iter().filter(|c| !c.pass).count();
     println!(
         "{} models, {} checks, {} failed → {}",
@@ -141,6 +157,13 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
         failed,
         out.join("REPORT.md").display()
     );
+    if failed > 0 {
+        bail!(
+            "{failed} of {} MODELS.md §8 checks failed (see {})",
+            checks.len(),
+            out.join("REPORT.md").display()
+        );
+    }
     Ok(())
 }
 
@@ -338,10 +361,14 @@ fn write_figures(
     Ok(names)
 }
 
-/// The git revision, marked when tracked files other than the report's own output differ.
+/// The git revision of the project this binary was built from (wherever it runs), marked when
+/// tracked files other than the report's own output differ.
 fn git_revision(out: &Path) -> String {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let run = |args: &[&str]| {
         std::process::Command::new("git")
+            .arg("-C")
+            .arg(&root)
             .args(args)
             .output()
             .ok()
@@ -351,11 +378,15 @@ fn git_revision(out: &Path) -> String {
     let Some(rev) = run(&["rev-parse", "--short=12", "HEAD"]) else {
         return "unknown (not a git checkout)".into();
     };
-    let out = out
-        .to_string_lossy()
-        .trim_start_matches("./")
-        .trim_end_matches('/')
-        .to_owned();
+    // The output directory as git names it (relative to the project root); empty when it lies
+    // outside the project, where every change counts.
+    let out = match (out.canonicalize(), root.canonicalize()) {
+        (Ok(out), Ok(root)) => out
+            .strip_prefix(&root)
+            .map(|p| p.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        _ => String::new(),
+    };
     let dirty = run(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| {
         s.lines().any(|l| {
             let path = l.get(3..).unwrap_or("");
@@ -379,9 +410,11 @@ fn rustc_version() -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
+#[allow(clippy::too_many_arguments)]
 fn write_markdown(
     base: &Scenario,
     outcomes: &[Outcome],
+    ends: &[EndState],
     checks: &[Check],
     eq15: f64,
     figures: &[(String, String)],
@@ -431,14 +464,14 @@ fn write_markdown(
             "| model | closed-loop mode [rad/s] | damping ratio | refined peak z / error [rad/s] | plain FFT peak of z over [0, 5] s [rad/s] |"
         )?;
         writeln!(w, "|---|---|---|---|---|")?;
-        for o in outcomes {
+        for (o, end) in outcomes.iter().zip(ends) {
             let m = &o.metrics;
             writeln!(
                 w,
                 "| {} | {:.4} | {:.2e} | {:.4} / {:.4} | {:.4} (bin {}) |",
                 o.kind,
-                o.end.mode.omega,
-                o.end.mode.damping_ratio(),
+                end.mode.omega,
+                end.mode.damping_ratio(),
                 m.z_peak_rad_s,
                 m.err_peak_rad_s,
                 m.z_fft_0_5_bin_rad_s,
@@ -465,15 +498,15 @@ fn write_markdown(
             "| model | z at x1 [m] | F0 at x1 [N] | z at x2 [m] | F0 at x2 [N] |"
         )?;
         writeln!(w, "|---|---|---|---|---|")?;
-        for o in outcomes {
+        for (o, end) in outcomes.iter().zip(ends) {
             writeln!(
                 w,
                 "| {} | {} | {} | {} | {} |",
                 o.kind,
                 fixed(o.metrics.z0, 7),
                 fixed(o.metrics.f0, 6),
-                fixed(o.end.effector.y, 7),
-                fixed(o.end.equilibrium.force, 6)
+                fixed(end.effector.y, 7),
+                fixed(end.equilibrium.force, 6)
             )?;
         }
 

@@ -3,7 +3,7 @@
 //! The evidence behind docs/numerics.md's claim for the lumped statics beside a pulley (0 failures in
 //! 500 000 starts on the default grid, the property test's ranges), and a way to re-check it.
 
-use crate::output::progress_bar;
+use crate::output::Progress;
 use crate::simulate::{load_scenario, model_kind};
 use anyhow::{Result, bail};
 use cdpr_bench::ModelKind;
@@ -86,11 +86,9 @@ pub fn run(
     x.check("x", 0.0, scenario.robot.anchor_distance)?;
     tension_sum.check("tension", 0.0, f64::INFINITY)?;
     let kind = model_kind(&scenario)?.name();
-    let bar = progress_bar(kind);
-    let (failures, starts) = sweep(&scenario, x, tension_sum, &mut |f| {
-        bar.set_position((f * 1000.0) as u64)
-    })?;
-    bar.finish_and_clear();
+    let mut progress = Progress::new(kind);
+    let (failures, starts) = sweep(&scenario, x, tension_sum, &mut |f| progress.set(f))?;
+    progress.finish();
     for f in &failures {
         println!("x = {} m, ΣT = {} N: {}", f.x, f.tension_sum, f.why);
     }

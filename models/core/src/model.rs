@@ -174,7 +174,7 @@ pub trait CableModel {
 
 /// A model's own parameters (its keys of the scenario's `[model]` section): what checks a
 /// scenario against the model's needs and builds the model from it.
-pub trait ModelParams {
+pub trait ModelParams: serde::Serialize {
     type Model: CableModel + Clone + Send + 'static;
     /// The model's own checks of the scenario (e.g. enough modelled cable for the trajectory),
     /// before any work starts.

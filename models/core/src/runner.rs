@@ -11,6 +11,7 @@ use cdpr_numerics::{
     Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions, IntegratorError, SolverStats,
     Stepper,
 };
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Why a run stopped early.
@@ -27,6 +28,9 @@ pub enum RunError {
     /// A commanded tension ≤ 0 (MODELS.md §2): a cable cannot push.
     #[error("cable {cable} went slack at t = {t} s: commanded tension {tension} N ≤ 0")]
     SlackCable { t: f64, cable: usize, tension: f64 },
+    /// Stopped from outside (an interrupt) after the step that reached `t`.
+    #[error("interrupted at t = {t} s")]
+    Interrupted { t: f64 },
     /// The scenario asks for an integrator the model does not support.
     #[error(
         "simulation.integrator = \"{integrator}\" is not available for the {model} model: {why}"
@@ -146,6 +150,55 @@ impl From<&Scenario> for RunOptions {
     }
 }
 
+/// The names of a run's channels with `model`, in order: [`Channel::COMMON`], the model's own,
+/// [`Channel::ENERGY`].
+pub fn channel_names<M: CableModel + ?Sized>(model: &M) -> Vec<String> {
+    let mut names: Vec<String> = Channel::COMMON.map(|c| c.name().to_owned()).to_vec();
+    names.extend(model.channel_names());
+    names.extend(Channel::ENERGY.map(|c| c.name().to_owned()));
+    names
+}
+
+/// Receives one sample row (the run's channels, in order).
+pub type SampleSink<'a> = dyn FnMut(&[f64]) + 'a;
+
+/// What a caller watches and steers while a run goes: its progress, each sample as it is taken,
+/// and a flag that stops it.
+pub struct Observer<'a> {
+    /// Receives the fraction of time done after each accepted step.
+    pub progress: &'a mut dyn FnMut(f64),
+    /// Receives each sample row (the run's channels, in order) as soon as it is taken, e.g. to
+    /// stream it to disk so that a killed run leaves what it sampled.
+    pub on_sample: Option<&'a mut SampleSink<'a>>,
+    /// When set (e.g. by a signal handler), the run stops after the current step with
+    /// [`RunError::Interrupted`], keeping what it sampled.
+    pub stop: Option<&'a AtomicBool>,
+}
+
+impl<'a> Observer<'a> {
+    /// An observer of the progress only.
+    pub fn progress(progress: &'a mut dyn FnMut(f64)) -> Self {
+        Self {
+            progress,
+            on_sample: None,
+            stop: None,
+        }
+    }
+
+    fn stopped(&self) -> bool {
+        self.stop.is_some_and(|s| s.load(Ordering::Relaxed))
+    }
+
+    /// Hands the rows of `series` from `from` on to `on_sample`.
+    fn emit(&mut self, series: &TimeSeries, from: usize) {
+        if let Some(sink) = self.on_sample.as_mut() {
+            for i in from..series.len() {
+                sink(series.row(i));
+            }
+        }
+    }
+}
+
 /// Integrates the loop from its MODELS.md §2 initial state to `t_final`, sampling every
 /// `sample_period` on the dense output. `progress` receives the fraction of time done after each
 /// accepted step.
@@ -155,6 +208,21 @@ pub fn simulate<M: CableModel>(
     progress: &mut dyn FnMut(f64),
 ) -> Result<Run, Box<RunFailure>> {
     simulate_reusing(sys, opts, Vec::new(), progress)
+}
+
+/// As [`simulate`], watched and steered by `observer`.
+pub fn simulate_observed<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+    opts: &RunOptions,
+    observer: &mut Observer,
+) -> Result<Run, Box<RunFailure>> {
+    let (y0, equilibrium) = sys.initial_state().map_err(|e| {
+        Box::new(RunFailure {
+            error: e.into(),
+            partial: None,
+        })
+    })?;
+    integrate_and_sample(sys, y0, equilibrium, opts, Vec::new(), observer)
 }
 
 /// As [`simulate`], writing the samples into `buffer`'s memory (from [`TimeSeries::into_buffer`]
@@ -171,7 +239,14 @@ pub fn simulate_reusing<M: CableModel>(
             partial: None,
         })
     })?;
-    integrate_and_sample(sys, y0, equilibrium, opts, buffer, progress)
+    integrate_and_sample(
+        sys,
+        y0,
+        equilibrium,
+        opts,
+        buffer,
+        &mut Observer::progress(progress),
+    )
 }
 
 /// As [`simulate`], from a given closed-loop state `y0` at t = 0 (`equilibrium` is reported as the
@@ -183,7 +258,14 @@ pub fn simulate_from<M: CableModel>(
     opts: &RunOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Run, Box<RunFailure>> {
-    integrate_and_sample(sys, y0, equilibrium, opts, Vec::new(), progress)
+    integrate_and_sample(
+        sys,
+        y0,
+        equilibrium,
+        opts,
+        Vec::new(),
+        &mut Observer::progress(progress),
+    )
 }
 
 fn integrate_and_sample<M: CableModel>(
@@ -192,13 +274,11 @@ fn integrate_and_sample<M: CableModel>(
     equilibrium: Equilibrium,
     opts: &RunOptions,
     buffer: Vec<f64>,
-    progress: &mut dyn FnMut(f64),
+    observer: &mut Observer,
 ) -> Result<Run, Box<RunFailure>> {
     let start = Instant::now();
     let n = sys.model_len();
-    let mut names: Vec<String> = Channel::COMMON.map(|c| c.name().to_owned()).to_vec();
-    names.extend(sys.model.channel_names());
-    names.extend(Channel::ENERGY.map(|c| c.name().to_owned()));
+    let names = channel_names(&sys.model);
     let samples = (opts.t_final / opts.sample_period).round() as usize + 1;
     let mut sampler = Sampler {
         series: TimeSeries::with_buffer(names, samples, buffer),
@@ -245,7 +325,7 @@ fn integrate_and_sample<M: CableModel>(
                 stepper,
                 &mut sampler,
                 &mut events,
-                progress,
+                observer,
             )
         };
     let t_reached = if stepper.stats().rhs_evals == 0 {
@@ -284,7 +364,7 @@ fn integrate<M: CableModel>(
     stepper: &mut dyn Stepper<ClosedLoop<M>>,
     sampler: &mut Sampler,
     events: &mut Vec<ModelEvent>,
-    progress: &mut dyn FnMut(f64),
+    observer: &mut Observer,
 ) -> Result<(), RunError> {
     let integrator = |t: f64| move |source| RunError::Integrator { t, source };
     stepper
@@ -292,21 +372,28 @@ fn integrate<M: CableModel>(
         .map_err(integrator(0.0))?;
     let mut monitor = EventMonitor::new(sys, y0);
     sampler.sample_through(sys, stepper, 0.0)?;
+    observer.emit(&sampler.series, 0);
     while stepper.time() < t_end {
+        if observer.stopped() {
+            return Err(RunError::Interrupted { t: stepper.time() });
+        }
         stepper
             .step(sys, t_end)
             .map_err(integrator(stepper.time()))?;
+        let taken = sampler.series.len();
         let Some((index, t_event)) = monitor.earliest_crossing(sys, stepper) else {
             let t = stepper.time();
             sampler.sample_through(sys, stepper, t)?;
+            observer.emit(&sampler.series, taken);
             check_slack(t, sys.command(t, stepper.state()).tensions)?;
             monitor.accept(sys, stepper.state());
-            progress(t / t_end);
+            (observer.progress)(t / t_end);
             continue;
         };
         // Samples up to the event come from the step as integrated; the event changes the state
         // there and the integrator restarts from it, abandoning the rest of the step.
         sampler.sample_through(sys, stepper, t_event)?;
+        observer.emit(&sampler.series, taken);
         let mut y = vec![0.0; y0.len()];
         stepper.dense_output(t_event, &mut y);
         let n = sys.model_len();

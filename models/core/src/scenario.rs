@@ -42,7 +42,7 @@ pub fn out_of_range(
 }
 
 /// Robot geometry and effector (MODELS.md §1).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Robot {
     /// Distance d between the pulleys A1 = (0, 0) and A2 = (d, 0) [m] (paper: 1 m).
@@ -64,7 +64,7 @@ impl Default for Robot {
 }
 
 /// Cable material (MODELS.md §1).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Cable {
     /// Young's modulus E [Pa] (paper: 102 GPa).
@@ -110,7 +110,7 @@ impl Cable {
 pub struct ModelSection(pub toml::Table);
 
 /// PID gains and tension distribution (MODELS.md §2).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Controller {
     /// Proportional gain P [N/m].
@@ -144,7 +144,7 @@ impl Default for Controller {
 }
 
 /// Trajectory family; the paper uses only `step5` (eq. 13).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum TrajectoryKind {
     #[default]
@@ -152,7 +152,7 @@ pub enum TrajectoryKind {
 }
 
 /// Reference trajectory of the effector's x (paper §3.1).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Trajectory {
     pub kind: TrajectoryKind,
@@ -179,7 +179,7 @@ impl Default for Trajectory {
 }
 
 /// Time integrator family.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum IntegratorKind {
     /// Dormand–Prince 5(4) with dense output (the paper's ode45).
@@ -200,7 +200,7 @@ impl IntegratorKind {
 }
 
 /// Implicit method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default, serde::Serialize)]
 pub enum ImplicitMethod {
     #[default]
     #[serde(rename = "generalized-alpha")]
@@ -208,7 +208,7 @@ pub enum ImplicitMethod {
 }
 
 /// Integration settings (MODELS.md §1, §6).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Simulation {
     /// Final time [s].
@@ -245,9 +245,29 @@ impl Default for Simulation {
     }
 }
 
+/// Whether a run computes the closed-loop modes at the end of the move.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ModesChoice {
+    /// When the linearised loop is small enough for the dense eigen-analysis (up to
+    /// `cdpr_analysis::linearise::DENSE_MAX_STATES` states); skipped with a note above it.
+    #[default]
+    Auto,
+    /// Never.
+    Off,
+}
+
+/// The analyses a run makes besides integrating (MODELS.md §7's metrics are always computed).
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct Analysis {
+    /// The closed-loop modes at the end of the move (the vertical mode of MODELS.md §8).
+    pub modes: ModesChoice,
+}
+
 /// One run, validated. Construct with [`Scenario::from_toml_str`], [`Scenario::from_file`] or
 /// [`Scenario::paper`]; after changing fields by hand call [`Scenario::validate`].
-#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Default, serde::Serialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Scenario {
     pub robot: Robot,
@@ -256,7 +276,11 @@ pub struct Scenario {
     pub controller: Controller,
     pub trajectory: Trajectory,
     pub simulation: Simulation,
+    pub analysis: Analysis,
 }
+
+/// Fewest implicit steps over the move [t1, t2] ([`Scenario::largest_implicit_step`]).
+pub const STEPS_PER_MOVE: f64 = 20.0;
 
 /// Largest number of output samples accepted (memory guard: ~50 channels × 8 B each).
 pub const MAX_SAMPLES: f64 = 2.0e7;
@@ -395,12 +419,38 @@ impl Scenario {
             ));
         }
         positive("simulation.step", s.step)?;
+        if s.integrator == IntegratorKind::Implicit {
+            let largest = self.largest_implicit_step();
+            if s.step > largest {
+                return Err(out_of_range(
+                    "simulation.step",
+                    s.step,
+                    format!(
+                        "≤ {largest:e} s for this scenario: the fixed step must resolve the move \
+                         (at least {STEPS_PER_MOVE} steps over t2 − t1 = {} s) and the PID's \
+                         derivative filter (h ≤ 1/filter = {:e} s)",
+                        t.t2 - t.t1,
+                        1.0 / self.controller.filter
+                    ),
+                ));
+            }
+        }
         finite("simulation.rho_inf", s.rho_inf)?;
         if !(0.0..=1.0).contains(&s.rho_inf) {
             return Err(out_of_range("simulation.rho_inf", s.rho_inf, "[0, 1]"));
         }
 
         Ok(())
+    }
+
+    /// The largest fixed step [s] the implicit path accepts: generalised-α is unconditionally
+    /// stable, so nothing stops a step that skips over the physics but this rule. The step must
+    /// resolve the move ([`STEPS_PER_MOVE`] steps over [t1, t2]) and the controller's fastest
+    /// dynamics, the derivative filter's time constant 1/N_f (paper: 1.85 ms; the paper runs use
+    /// 1e-4 s). A step of 1 s was accepted before and returned T1 min 76.1 N instead of 91.8 N.
+    pub fn largest_implicit_step(&self) -> f64 {
+        let t = &self.trajectory;
+        ((t.t2 - t.t1) / STEPS_PER_MOVE).min(1.0 / self.controller.filter)
     }
 
     /// The free cable length the trajectory needs, for the massive-cable models' rule on

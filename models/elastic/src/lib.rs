@@ -33,8 +33,8 @@ const VX: usize = 2;
 const VZ: usize = 3;
 
 /// The elastic model has no keys of its own in the `[model]` section, and stores no cable.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Params;
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub struct Params {}
 
 impl ModelParams for Params {
     type Model = Elastic;

@@ -36,7 +36,9 @@ pub enum FeStored {
 pub struct Params {
     /// Elements per free span, N (`model.elements`).
     pub elements: usize,
+    #[serde(rename = "fe_mass")]
     pub mass: FeMass,
+    #[serde(rename = "fe_stored")]
     pub stored: FeStored,
 }
 
