@@ -1,19 +1,27 @@
 //! The metrics of MODELS.md §7 computed from a run's samples: the numbers the paper reports
 //! (tension extremes and settling, error, overshoot, z oscillation, spectral peaks) and the cost.
 //!
-//! Windows are the paper's: the transition [t1, t2], "after 1 s" = [1 s, t_final], the settled
-//! means over the last second [t_final − 1, t_final] (= [4, 5] s for the paper), spectra over
-//! [1 s, t_final) and the whole record [0, t_final].
+//! Every window is defined from the scenario's move [t1, t2] and the record's end t_final
+//! ([`Windows`]), so that a key measures what its name says whatever the timing: the paper's
+//! "after 1 s" is [t2 + 0.8 s, t_final] (= [1, 5] s for its move ending at 0.2 s). A metric whose
+//! window the run does not reach, or is too short for, is NaN (null in `metrics.json`) and
+//! [`Metrics::unavailable`] says why. [`UNITS`] and the field docs below are the definitions.
 
 use crate::spectrum::{Peak, Spectrum, Window};
 use cdpr_core::channel::Channel;
 use cdpr_core::runner::Run;
 use cdpr_core::trajectory::Step5;
 
-/// Start of the settled window of the paper ("after 1 s") [s].
-pub const SETTLED_FROM: f64 = 1.0;
-/// Start of the strict settled window of MODELS.md §8 [s].
-pub const STRICT_SETTLED_FROM: f64 = 1.5;
+/// The settled window starts this long after the move ends [s]: the paper's "after 1 s" for its
+/// move ending at t2 = 0.2 s.
+pub const SETTLE_AFTER_MOVE: f64 = 0.8;
+/// The strict settled window of MODELS.md §8 (paper: [1.5, 5] s) starts this long after the
+/// move ends [s].
+pub const STRICT_SETTLE_AFTER_MOVE: f64 = 1.3;
+/// Length of the window of the settled means at the end of the record [s] (paper: [4, 5] s).
+pub const LAST_WINDOW: f64 = 1.0;
+/// Shortest window a spectral peak is taken over [s]: its bins are then at most 2π rad/s apart.
+pub const MIN_SPECTRAL_WINDOW: f64 = 1.0;
 /// The high-frequency search starts above the physics of the effector (MODELS.md §7) [rad/s].
 pub const HF_FROM: f64 = 100.0;
 /// Refined peaks ignore the drift below this frequency [rad/s].
@@ -25,10 +33,42 @@ pub const HF_PEAKS: usize = 8;
 /// Two events of one cable closer than this are counted as chatter [s].
 pub const CHATTER_WINDOW: f64 = 1e-3;
 
-/// MODELS.md §7 metrics of one run. Keys are those of `metrics.json`.
+/// The windows of a run's metrics [s], each [start, end].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Windows {
+    /// The move: [t1, t2].
+    pub transition: [f64; 2],
+    /// After the move has settled: [t2 + [`SETTLE_AFTER_MOVE`], t_final].
+    pub settled: [f64; 2],
+    /// [t2 + [`STRICT_SETTLE_AFTER_MOVE`], t_final].
+    pub settled_strict: [f64; 2],
+    /// The record's last [`LAST_WINDOW`]: [t_final − 1 s, t_final].
+    pub last: [f64; 2],
+    /// The whole record: [0, t_final].
+    pub record: [f64; 2],
+}
+
+impl Windows {
+    /// The windows of a move `step5` recorded until `t_end` [s].
+    pub fn new(step5: &Step5, t_end: f64) -> Self {
+        Self {
+            transition: [step5.t1, step5.t2],
+            settled: [step5.t2 + SETTLE_AFTER_MOVE, t_end],
+            settled_strict: [step5.t2 + STRICT_SETTLE_AFTER_MOVE, t_end],
+            last: [t_end - LAST_WINDOW, t_end],
+            record: [0.0, t_end],
+        }
+    }
+}
+
+/// MODELS.md §7 metrics of one run. Keys are those of `metrics.json`; NaN is null there.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Metrics {
     pub model: String,
+    /// The windows the metrics below are measured over.
+    pub windows: Windows,
+    /// Each metric that is NaN because the run does not reach or fill its window, and why.
+    pub unavailable: std::collections::BTreeMap<&'static str, String>,
     /// Minimum of the commanded T1 [N] and when [s].
     pub t1_min: f64,
     pub t1_min_time: f64,
@@ -41,31 +81,34 @@ pub struct Metrics {
     /// Commanded tensions at t_final [N].
     pub t1_final: f64,
     pub t2_final: f64,
-    /// Means of the commanded tensions over the last second [N].
-    pub t1_mean_4_5: f64,
-    pub t2_mean_4_5: f64,
-    /// max |x_ref − x| over [t1, t2] [m].
+    /// Means of the commanded tensions over the `last` window, which must lie in the settled
+    /// one [N].
+    pub t1_mean_last_1s: f64,
+    pub t2_mean_last_1s: f64,
+    /// max |x_ref − x| over the `transition` window [m].
     pub err_max_transition: f64,
-    /// max |x_ref − x| over [1 s, t_final] [m].
-    pub err_max_after_1s: f64,
-    /// max |x_ref − x| over [1.5 s, t_final] [m].
-    pub err_max_after_1_5s: f64,
+    /// max |x_ref − x| over the `settled` window [m].
+    pub err_max_settled: f64,
+    /// max |x_ref − x| over the `settled_strict` window [m].
+    pub err_max_settled_strict: f64,
     /// max over the run of (x − x2)·sign(x2 − x1) [m] (negative: no overshoot).
     pub overshoot: f64,
-    /// Mean and peak-to-peak of z over [1 s, t_final] [m].
+    /// Mean and peak-to-peak of z over the `settled` window [m].
     pub z_mean: f64,
     pub z_p2p: f64,
-    /// Refined spectral peaks (Hann, 16× padding, ω ≥ 2 rad/s) of z and of the error over
-    /// [1 s, t_final) [rad/s].
+    /// Refined spectral peaks (Hann, 16× padding, ω ≥ 2 rad/s) of z and of the error over the
+    /// `settled` window, at least [`MIN_SPECTRAL_WINDOW`] long [rad/s].
     pub z_peak_rad_s: f64,
     pub err_peak_rad_s: f64,
-    /// Plain FFT peaks (rectangular window, no padding) over [1 s, t_final) [rad/s].
+    /// Plain FFT peaks (rectangular window, no padding) over the `settled` window [rad/s].
     pub z_plain_peak_rad_s: f64,
     pub err_plain_peak_rad_s: f64,
-    /// Plain FFT peak of z over the whole record [0, t_final] [rad/s] and its bin index.
-    pub z_fft_0_5_bin_rad_s: f64,
-    pub z_fft_0_5_bin: usize,
-    /// Largest local maximum of the refined error spectrum above 100 rad/s [rad/s] and its level
+    /// Plain FFT peak of z over the whole `record`, at least [`MIN_SPECTRAL_WINDOW`] long
+    /// [rad/s], and its bin index (the paper's 20.11 rad/s is bin 16 of its 5 s record).
+    pub z_fft_record_rad_s: f64,
+    pub z_fft_record_bin: usize,
+    /// Largest local maximum of the refined error spectrum above 100 rad/s over the `settled`
+    /// window [rad/s] and its level
     /// relative to the main error peak [dB].
     pub err_hf_peak_rad_s: f64,
     pub err_hf_peak_db: f64,
@@ -101,6 +144,8 @@ pub struct Metrics {
 /// `err_hf_peaks` holds [rad/s, dB] pairs).
 pub const UNITS: &[(&str, &str)] = &[
     ("model", ""),
+    ("windows", "s"),
+    ("unavailable", ""),
     ("t1_min", "N"),
     ("t1_min_time", "s"),
     ("t1_max", "N"),
@@ -111,11 +156,11 @@ pub const UNITS: &[(&str, &str)] = &[
     ("t2_max_time", "s"),
     ("t1_final", "N"),
     ("t2_final", "N"),
-    ("t1_mean_4_5", "N"),
-    ("t2_mean_4_5", "N"),
+    ("t1_mean_last_1s", "N"),
+    ("t2_mean_last_1s", "N"),
     ("err_max_transition", "m"),
-    ("err_max_after_1s", "m"),
-    ("err_max_after_1_5s", "m"),
+    ("err_max_settled", "m"),
+    ("err_max_settled_strict", "m"),
     ("overshoot", "m"),
     ("z_mean", "m"),
     ("z_p2p", "m"),
@@ -123,8 +168,8 @@ pub const UNITS: &[(&str, &str)] = &[
     ("err_peak_rad_s", "rad/s"),
     ("z_plain_peak_rad_s", "rad/s"),
     ("err_plain_peak_rad_s", "rad/s"),
-    ("z_fft_0_5_bin_rad_s", "rad/s"),
-    ("z_fft_0_5_bin", ""),
+    ("z_fft_record_rad_s", "rad/s"),
+    ("z_fft_record_bin", ""),
     ("err_hf_peak_rad_s", "rad/s"),
     ("err_hf_peak_db", "dB"),
     ("err_hf_peaks", "[rad/s, dB]"),
@@ -219,11 +264,12 @@ impl Metrics {
         let (t1_max_time, t1_max) = extreme(&t, &t1, |a, b| a > b);
         let (t2_min_time, t2_min) = extreme(&t, &t2, |a, b| a < b);
         let (t2_max_time, t2_max) = extreme(&t, &t2, |a, b| a > b);
-        let last = window(&t, t_end - 1.0, t_end, true, dt);
+        let windows = Windows::new(step5, t_end);
+        let last = window(&t, windows.last[0], t_end, true, dt);
         let transition = window(&t, step5.t1, step5.t2, true, dt);
-        let settled = window(&t, SETTLED_FROM, t_end, true, dt);
-        let strict = window(&t, STRICT_SETTLED_FROM, t_end, true, dt);
-        let spectral = window(&t, SETTLED_FROM, t_end, false, dt);
+        let settled = window(&t, windows.settled[0], t_end, true, dt);
+        let strict = window(&t, windows.settled_strict[0], t_end, true, dt);
+        let spectral = window(&t, windows.settled[0], t_end, false, dt);
 
         let direction = (step5.x2 - step5.x1).signum();
         let overshoot = x
@@ -260,8 +306,10 @@ impl Metrics {
             *slot = e.t;
         }
 
-        Self {
+        let mut metrics = Self {
             model: run.model.to_owned(),
+            windows,
+            unavailable: Default::default(),
             t1_min,
             t1_min_time,
             t1_max,
@@ -272,11 +320,11 @@ impl Metrics {
             t2_max_time,
             t1_final: t1.last().copied().unwrap_or(f64::NAN),
             t2_final: t2.last().copied().unwrap_or(f64::NAN),
-            t1_mean_4_5: mean(&t1[last.clone()]),
-            t2_mean_4_5: mean(&t2[last]),
+            t1_mean_last_1s: mean(&t1[last.clone()]),
+            t2_mean_last_1s: mean(&t2[last]),
             err_max_transition: max_abs(&err[transition]),
-            err_max_after_1s: max_abs(&err[settled.clone()]),
-            err_max_after_1_5s: max_abs(&err[strict]),
+            err_max_settled: max_abs(&err[settled.clone()]),
+            err_max_settled_strict: max_abs(&err[strict]),
             overshoot,
             z_mean: mean(zs),
             z_p2p,
@@ -284,8 +332,8 @@ impl Metrics {
             err_peak_rad_s: peak_omega(err_main),
             z_plain_peak_rad_s: peak_omega(z_spec.plain.max_bin(0.0)),
             err_plain_peak_rad_s: peak_omega(err_spec.plain.max_bin(0.0)),
-            z_fft_0_5_bin_rad_s: peak_omega(whole),
-            z_fft_0_5_bin: whole.map_or(0, |p| p.bin),
+            z_fft_record_rad_s: peak_omega(whole),
+            z_fft_record_bin: whole.map_or(0, |p| p.bin),
             err_hf_peak_rad_s: peak_omega(err_hf),
             err_hf_peak_db,
             err_hf_peaks,
@@ -303,6 +351,88 @@ impl Metrics {
             factorisations: run.stats.factorisations,
             pivotings: run.stats.pivotings,
             wall_s: run.wall_s,
+        };
+        metrics.mark_unavailable();
+        metrics
+    }
+
+    /// Sets to NaN, with the reason, every metric whose window the run does not reach or fill.
+    fn mark_unavailable(&mut self) {
+        let w = self.windows;
+        let t_end = w.record[1];
+        let mut unavailable = Vec::new();
+        if t_end < w.transition[1] {
+            let why = format!(
+                "the run ends at {t_end} s, before the move ends at t2 = {} s",
+                w.transition[1]
+            );
+            unavailable.push((&mut self.err_max_transition, "err_max_transition", why));
+        }
+        let settled = format!(
+            "the run ends at {t_end} s, before the settled window starts at t2 + {SETTLE_AFTER_MOVE} s = {} s",
+            w.settled[0]
+        );
+        if t_end <= w.settled[0] {
+            for (value, key) in [
+                (&mut self.err_max_settled, "err_max_settled"),
+                (&mut self.z_mean, "z_mean"),
+                (&mut self.z_p2p, "z_p2p"),
+            ] {
+                unavailable.push((value, key, settled.clone()));
+            }
+        }
+        if t_end <= w.settled_strict[0] {
+            let why = format!(
+                "the run ends at {t_end} s, before the strict settled window starts at t2 + {STRICT_SETTLE_AFTER_MOVE} s = {} s",
+                w.settled_strict[0]
+            );
+            unavailable.push((
+                &mut self.err_max_settled_strict,
+                "err_max_settled_strict",
+                why,
+            ));
+        }
+        if w.last[0] < w.settled[0] {
+            let why = format!(
+                "the last {LAST_WINDOW} s of the record, from {} s, begins before the settled window at {} s: t_final must be ≥ t2 + {} s",
+                w.last[0],
+                w.settled[0],
+                SETTLE_AFTER_MOVE + LAST_WINDOW
+            );
+            for (value, key) in [
+                (&mut self.t1_mean_last_1s, "t1_mean_last_1s"),
+                (&mut self.t2_mean_last_1s, "t2_mean_last_1s"),
+            ] {
+                unavailable.push((value, key, why.clone()));
+            }
+        }
+        if w.settled[1] - w.settled[0] < MIN_SPECTRAL_WINDOW {
+            let why = format!(
+                "the settled window [{}, {t_end}] s is shorter than the {MIN_SPECTRAL_WINDOW} s a spectral peak needs",
+                w.settled[0]
+            );
+            for (value, key) in [
+                (&mut self.z_peak_rad_s, "z_peak_rad_s"),
+                (&mut self.err_peak_rad_s, "err_peak_rad_s"),
+                (&mut self.z_plain_peak_rad_s, "z_plain_peak_rad_s"),
+                (&mut self.err_plain_peak_rad_s, "err_plain_peak_rad_s"),
+                (&mut self.err_hf_peak_rad_s, "err_hf_peak_rad_s"),
+                (&mut self.err_hf_peak_db, "err_hf_peak_db"),
+            ] {
+                unavailable.push((value, key, why.clone()));
+            }
+            self.err_hf_peaks.clear();
+        }
+        if t_end < MIN_SPECTRAL_WINDOW {
+            let why = format!(
+                "the record of {t_end} s is shorter than the {MIN_SPECTRAL_WINDOW} s a spectral peak needs"
+            );
+            unavailable.push((&mut self.z_fft_record_rad_s, "z_fft_record_rad_s", why));
+            self.z_fft_record_bin = 0;
+        }
+        for (value, key, why) in unavailable {
+            *value = f64::NAN;
+            self.unavailable.insert(key, why);
         }
     }
 }

@@ -11,7 +11,7 @@
 use crate::output::write_atomic;
 use anyhow::{Context, Result, anyhow};
 use cdpr_bench::ModelKind;
-use cdpr_bench::analysis::metrics::{PAD, SETTLED_FROM};
+use cdpr_bench::analysis::metrics::PAD;
 use cdpr_bench::analysis::spectrum::{Spectrum, Window};
 use cdpr_bench::core::channel::Channel;
 use cdpr_bench::core::runner::Run;
@@ -126,14 +126,21 @@ pub fn channel(run: &Run, channel: Channel, t0: f64, t1: f64, scale: f64) -> Vec
     envelope(&points)
 }
 
-/// The refined amplitude spectrum (Hann, 16× padding) of `channel` over [1 s, t_final),
-/// as (ω, amplitude) with the maximum kept per logarithmic bucket between `w0` and `w1` rad/s.
-pub fn spectrum(run: &Run, channel: Channel, dt: f64, w0: f64, w1: f64) -> Vec<(f64, f64)> {
+/// The refined amplitude spectrum (Hann, 16× padding) of `channel` over [`from`, t_final) (the
+/// metrics' settled window), as (ω, amplitude) with the maximum kept per logarithmic bucket
+/// between `w0` and `w1` rad/s.
+pub fn spectrum(
+    run: &Run,
+    channel: Channel,
+    from: f64,
+    dt: f64,
+    (w0, w1): (f64, f64),
+) -> Vec<(f64, f64)> {
     let (Some(t), Some(v)) = (run.series.column(Channel::Time), run.series.column(channel)) else {
         return Vec::new();
     };
     let t_end = t.last().copied().unwrap_or(0.0);
-    let start = t.partition_point(|&x| x < SETTLED_FROM - 0.5 * dt);
+    let start = t.partition_point(|&x| x < from - 0.5 * dt);
     let end = t.partition_point(|&x| x < t_end - 0.5 * dt);
     if end <= start + 2 {
         return Vec::new();

@@ -11,7 +11,7 @@ use anyhow::{Result, bail};
 use cdpr_bench::Assessed as Outcome;
 use cdpr_bench::ModelKind;
 use cdpr_bench::analysis::linearise::EndState;
-use cdpr_bench::analysis::metrics::Metrics;
+use cdpr_bench::analysis::metrics::{Metrics, Windows};
 use cdpr_bench::core::channel::Channel;
 use cdpr_bench::core::runner::Run;
 use cdpr_bench::core::scenario::Scenario;
@@ -201,6 +201,7 @@ fn write_figures(
     let t_end = base.simulation.t_final;
     let dt = base.simulation.sample_period;
     let step5 = Step5::from(&base.trajectory);
+    let settled_from = Windows::new(&step5, t_end).settled[0];
     let black = RGBColor(0, 0, 0);
     let panel = |x: &str, y: &str, lines: Vec<Line>, markers: Vec<Marker>, log_y: bool| Panel {
         x_label: x.into(),
@@ -263,7 +264,9 @@ fn write_figures(
         y_label: label.into(),
         log_x: true,
         log_y: true,
-        lines: lines(&c, |r| figures::spectrum(r, channel, dt, 1.0, 2.0e5)),
+        lines: lines(&c, |r| {
+            figures::spectrum(r, channel, settled_from, dt, (1.0, 2.0e5))
+        }),
         markers: vec![Marker::Vertical(eq15, format!("eq. 15: {eq15:.2} rad/s"))],
     };
     figures_out.push(Figure {
@@ -474,8 +477,8 @@ fn write_markdown(
                 end.mode.damping_ratio(),
                 m.z_peak_rad_s,
                 m.err_peak_rad_s,
-                m.z_fft_0_5_bin_rad_s,
-                m.z_fft_0_5_bin
+                m.z_fft_record_rad_s,
+                m.z_fft_record_bin
             )?;
         }
 
@@ -484,7 +487,7 @@ fn write_markdown(
             .iter()
             .map(|o| {
                 let m = &o.metrics;
-                (o.kind.name(), m.z_peak_rad_s, m.z_fft_0_5_bin_rad_s)
+                (o.kind.name(), m.z_peak_rad_s, m.z_fft_record_rad_s)
             })
             .collect();
         modes.write_section(w, &peaks)?;

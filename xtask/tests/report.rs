@@ -115,7 +115,11 @@ fn report_writes_every_figure_table_and_file() {
     std::fs::create_dir_all(&again_dir).unwrap();
     std::fs::copy(dir.join("short.toml"), again_dir.join("short.toml")).unwrap();
     let again = report(&again_dir);
-    assert_eq!(again.status.code(), output.status.code(), "the same verdict again");
+    assert_eq!(
+        again.status.code(),
+        output.status.code(),
+        "the same verdict again"
+    );
     let second: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(again_dir.join("out/metrics.json")).unwrap())
             .unwrap();
