@@ -32,8 +32,14 @@ pub struct Line {
     pub label: String,
     pub color: RGBColor,
     pub dashed: bool,
+    /// Stroke width [SVG px]: wider lines are drawn first, so a thin line on top of a wide one
+    /// stays visible where two curves coincide.
+    pub width: f64,
     pub points: Vec<(f64, f64)>,
 }
+
+/// The stroke width of a line that shares its panel with no coinciding curve [SVG px].
+pub const LINE_WIDTH: f64 = 1.5;
 
 /// A vertical or horizontal reference line with a label.
 pub enum Marker {
@@ -62,7 +68,18 @@ pub struct Figure {
 pub struct Curve<'a> {
     pub label: &'a str,
     pub color: RGBColor,
+    pub width: f64,
     pub run: &'a Run,
+}
+
+/// The stroke width of each model in every figure [SVG px]: FE widest, drawn first, elastic
+/// narrowest, drawn last, so that the three remain distinguishable where they coincide.
+pub fn model_width(kind: ModelKind) -> f64 {
+    match kind {
+        ModelKind::Elastic => 1.0,
+        ModelKind::Lumped => 2.0,
+        ModelKind::Fe => 4.0,
+    }
 }
 
 /// The colour of each model in every figure.
@@ -253,8 +270,10 @@ where
         .titled(&figure.title, ("sans-serif", px(20.0)).into_font())
         .map_err(err)?;
     let areas = titled.split_evenly((figure.panels.len(), 1));
+    // One legend column for the figure, so that the panels' plots line up.
+    let legend = figure.panels.iter().map(legend_width).fold(0.0, f64::max);
     for (panel, area) in figure.panels.iter().zip(areas.iter()) {
-        draw_panel(area, panel, scale).map_err(err)?;
+        draw_panel(area, panel, legend, scale).map_err(err)?;
     }
     Ok(())
 }
@@ -294,6 +313,7 @@ pub(crate) fn power_label(v: &f64) -> String {
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
+    legend_width: f64,
     scale: f64,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let px = |v: f64| (v * scale).round() as u32;
@@ -329,6 +349,7 @@ fn draw_panel<DB: DrawingBackend>(
     let label_font = ("sans-serif", px(14.0)).into_font();
     let mut chart = ChartBuilder::on(area)
         .margin(px(8.0))
+        .margin_right(px(8.0 + legend_width))
         .x_label_area_size(px(40.0))
         .y_label_area_size(px(80.0))
         .build_cartesian_2d(x0..x1, y0..y1)?;
@@ -366,52 +387,194 @@ fn draw_panel<DB: DrawingBackend>(
         .axis_desc_style(label_font.clone())
         .light_line_style(RGBColor(235, 235, 235))
         .draw()?;
-    let stroke = px(1.5);
+    // Reference lines; their labels go to the legend, where they collide with nothing.
     for m in &panel.markers {
-        let grey = RGBColor(110, 110, 110).stroke_width(px(1.0));
-        let (points, text, at) = match m {
-            Marker::Vertical(x, text) => (vec![(tx(*x), y0), (tx(*x), y1)], text, (tx(*x), y1)),
-            Marker::Horizontal(y, text) => (vec![(x0, ty(*y)), (x1, ty(*y))], text, (x0, ty(*y))),
+        let points = match m {
+            Marker::Vertical(x, _) => vec![(tx(*x), y0), (tx(*x), y1)],
+            Marker::Horizontal(y, _) => vec![(x0, ty(*y)), (x1, ty(*y))],
         };
+        let grey = MARKER_GREY.stroke_width(px(1.0));
         chart.draw_series(DashedLineSeries::new(points, px(6.0), px(4.0), grey))?;
-        chart.draw_series(std::iter::once(Text::new(
-            format!(" {text}"),
-            at,
-            ("sans-serif", px(12.0))
-                .into_font()
-                .color(&RGBColor(80, 80, 80)),
-        )))?;
     }
-    for line in &panel.lines {
-        let style = line.color.stroke_width(stroke);
+    // Draw order: lines that oscillate far more than the others (a band, like the lumped
+    // model's tensions while its axial mode rings) first, so the smoother curves stay visible on
+    // top; among comparable lines the wider first, so a narrower one drawn over a coinciding
+    // curve stays visible. Lines are a little transparent where they still overlap.
+    let roughness = |l: &Line| {
+        let variation: f64 = l.points.windows(2).map(|p| (p[1].1 - p[0].1).abs()).sum();
+        variation.max(f64::MIN_POSITIVE).log2().floor()
+    };
+    let mut order: Vec<&Line> = panel.lines.iter().collect();
+    order.sort_by(|a, b| {
+        roughness(b)
+            .total_cmp(&roughness(a))
+            .then(b.width.total_cmp(&a.width))
+    });
+    for line in order {
+        let style = line
+            .color
+            .mix(LINE_OPACITY)
+            .stroke_width(px(line.width).max(1));
         let pts: Vec<(f64, f64)> = line
             .points
             .iter()
             .filter(valid)
             .map(|p| (tx(p.0), ty(p.1)))
             .collect();
-        let color = line.color;
-        let legend = move |(x, y): (i32, i32)| {
-            PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
-        };
         if line.dashed {
-            chart
-                .draw_series(DashedLineSeries::new(pts, px(8.0), px(5.0), style))?
-                .label(line.label.as_str())
-                .legend(legend);
+            chart.draw_series(DashedLineSeries::new(pts, px(8.0), px(5.0), style))?;
         } else {
-            chart
-                .draw_series(LineSeries::new(pts, style))?
-                .label(line.label.as_str())
-                .legend(legend);
+            // Segment by segment: a polyline's mitre joins at the sharp turns of an oscillation
+            // reach far beyond the data in the bitmap backend (which has no mitre limit).
+            chart.draw_series(
+                pts.windows(2)
+                    .map(|s| PathElement::new(vec![s[0], s[1]], style)),
+            )?;
         }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(label_font)
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(160, 160, 160))
-        .draw()?;
+    draw_legend(area, &chart, panel, scale)
+}
+
+/// Opacity of the data lines.
+const LINE_OPACITY: f64 = 0.75;
+
+/// The colour of reference lines (markers).
+const MARKER_GREY: RGBColor = RGBColor(110, 110, 110);
+
+/// One entry of a panel's legend: label, colour, dashed, width [SVG px].
+fn legend_entries(panel: &Panel) -> Vec<(String, RGBColor, bool, f64)> {
+    let lines = panel
+        .lines
+        .iter()
+        .map(|l| (l.label.clone(), l.color, l.dashed, l.width));
+    let markers = panel.markers.iter().map(|m| match m {
+        Marker::Vertical(_, text) | Marker::Horizontal(_, text) => {
+            (text.clone(), MARKER_GREY, true, 1.0)
+        }
+    });
+    lines.chain(markers).collect()
+}
+
+/// Width of the legend column right of a panel's plot [SVG px]: the sample, a gap and the
+/// longest label at ~7 px per character of the 13 px font.
+fn legend_width(panel: &Panel) -> f64 {
+    let chars = legend_entries(panel)
+        .iter()
+        .map(|e| e.0.chars().count())
+        .max()
+        .unwrap_or(0);
+    40.0 + 7.0 * chars as f64
+}
+
+/// The legend in the column right of the plot, so it never covers data: each line's sample in
+/// its own style (a dashed line's sample is dashed) and its label.
+fn draw_legend<DB: DrawingBackend, CT: CoordTranslate>(
+    area: &DrawingArea<DB, Shift>,
+    chart: &ChartContext<DB, CT>,
+    panel: &Panel,
+    scale: f64,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let px = |v: f64| (v * scale).round() as i32;
+    let (plot_x, plot_y) = chart.plotting_area().get_pixel_range();
+    let (area_x, area_y) = area.get_pixel_range();
+    let left = plot_x.end - area_x.start + px(10.0);
+    let top = plot_y.start - area_y.start + px(4.0);
+    let font = ("sans-serif", px(13.0) as u32).into_font();
+    for (k, (label, color, dashed, width)) in legend_entries(panel).into_iter().enumerate() {
+        let y = top + px(18.0) * k as i32 + px(8.0);
+        let style = color.stroke_width((px(width) as u32).max(1));
+        let sample = if dashed {
+            vec![
+                (left, y),
+                (left + px(8.0), y),
+                (left + px(14.0), y),
+                (left + px(22.0), y),
+            ]
+        } else {
+            vec![(left, y), (left + px(22.0), y)]
+        };
+        for pair in sample.chunks(2) {
+            area.draw(&PathElement::new(pair.to_vec(), style))?;
+        }
+        area.draw(&Text::new(
+            label,
+            (left + px(28.0), y - px(7.0)),
+            font.clone(),
+        ))?;
+    }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Pixels of the PNG of a one-panel figure: (width, height, RGB bytes).
+    fn rendered(figure: &Figure) -> image::RgbImage {
+        let dir = std::env::temp_dir().join(format!("cdpr-figure-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        render(figure, &dir).unwrap();
+        let png = image::open(dir.join(format!("{}.png", figure.name)))
+            .unwrap()
+            .to_rgb8();
+        let _ = std::fs::remove_dir_all(&dir);
+        png
+    }
+
+    /// A dense zigzag (every turn acute, where a polyline's mitre joins spike in the bitmap
+    /// backend: thousands of pixels over the tick labels in the report's Fig. 8) must stay
+    /// inside the plot: no pixel of its colour above or below the plot's grid, or left of it,
+    /// beyond the stroke's half width. The plot is found as the extent of the grid's light lines.
+    #[test]
+    fn png_draws_no_data_outside_the_plot() {
+        let magenta = RGBColor(255, 0, 255);
+        let points = (0..2000)
+            .map(|k| {
+                let sign = if k % 2 == 0 { -1.0 } else { 1.0 };
+                (k as f64, sign * (1.0 + 0.3 * (k as f64 * 0.01).sin()))
+            })
+            .collect();
+        let figure = Figure {
+            name: "zigzag".into(),
+            title: "zigzag".into(),
+            panels: vec![Panel {
+                x_label: "x".into(),
+                y_label: "y".into(),
+                log_x: false,
+                log_y: false,
+                lines: vec![Line {
+                    label: "zigzag".into(),
+                    color: magenta,
+                    dashed: false,
+                    width: LINE_WIDTH,
+                    points,
+                }],
+                markers: vec![],
+            }],
+        };
+        let png = rendered(&figure);
+        let grid = |p: &image::Rgb<u8>| p.0 == [235, 235, 235];
+        let (mut left, mut right, mut top, mut bottom) = (u32::MAX, 0, u32::MAX, 0);
+        for (x, y, p) in png.enumerate_pixels() {
+            if grid(p) {
+                (left, right) = (left.min(x), right.max(x));
+                (top, bottom) = (top.min(y), bottom.max(y));
+            }
+        }
+        assert!(left < right && top < bottom, "no grid found");
+        // Magenta at the lines' opacity over white or grid: red and blue high, green low.
+        let line = |p: &image::Rgb<u8>| p.0[0] > 200 && p.0[2] > 200 && p.0[1] < 150;
+        let slack = 3; // half the PNG stroke (3 px) rounded up
+        let outside = png
+            .enumerate_pixels()
+            .filter(|(x, y, p)| {
+                line(p)
+                    && *x <= right
+                    && (*x + slack < left || *y + slack < top || *y > bottom + slack)
+            })
+            .count();
+        let inside = png.pixels().filter(|p| line(p)).count();
+        assert!(inside > 10_000, "the zigzag was drawn ({inside} pixels)");
+        assert_eq!(outside, 0, "pixels of data outside the plot");
+    }
 }

@@ -173,6 +173,7 @@ fn curves(outcomes: &[Outcome]) -> Vec<Curve<'_>> {
         .map(|o| Curve {
             label: o.kind.name(),
             color: figures::model_color(o.kind),
+            width: figures::model_width(o.kind),
             run: &o.run,
         })
         .collect()
@@ -185,6 +186,7 @@ fn lines(curves: &[Curve], f: impl Fn(&Run) -> Vec<(f64, f64)>) -> Vec<Line> {
             label: c.label.to_owned(),
             color: c.color,
             dashed: false,
+            width: c.width,
             points: f(c.run),
         })
         .collect()
@@ -217,6 +219,7 @@ fn write_figures(
             label: "x_ref (step5)".into(),
             color: black,
             dashed: true,
+            width: figures::LINE_WIDTH,
             points: figures::channel(&first.run, Channel::XRef, 0.0, t_end, 1.0),
         });
     }
@@ -321,6 +324,7 @@ fn write_figures(
             label: label.into(),
             color: black,
             dashed: false,
+            width: figures::LINE_WIDTH,
             points,
         }]
     };
