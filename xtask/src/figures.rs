@@ -447,9 +447,10 @@ fn legend_entries(panel: &Panel) -> Vec<(String, RGBColor, bool, f64)> {
         .lines
         .iter()
         .map(|l| (l.label.clone(), l.color, l.dashed, l.width));
-    let markers = panel.markers.iter().map(|m| match m {
+    // A marker without text (the second of a ± pair) needs no entry of its own.
+    let markers = panel.markers.iter().filter_map(|m| match m {
         Marker::Vertical(_, text) | Marker::Horizontal(_, text) => {
-            (text.clone(), MARKER_GREY, true, 1.0)
+            (!text.is_empty()).then(|| (text.clone(), MARKER_GREY, true, 1.0))
         }
     });
     lines.chain(markers).collect()
