@@ -49,7 +49,7 @@ pub use config::{
     ModelConfig, scenario_from_file, scenario_from_toml_str, validate, with_model_kind,
 };
 pub use kind::ModelKind;
-pub use provenance::{Provenance, revision};
+pub use provenance::{Provenance, project_revision, revision};
 pub use study::{
     Assessed, EndAnalysis, Error, analyse, assess, assess_observed, damping_sweep, end_analysis,
     end_state, eq15_at_end, growth_resolution, linearise, metrics, mode_as_integrated, simulate,

@@ -40,8 +40,20 @@ impl Provenance {
 }
 
 /// The git revision of the project this binary was built from (not of the working directory):
-/// `git rev-parse` in the source tree, with `+` for uncommitted changes to tracked files.
+/// 12 hex digits, with `+` for uncommitted changes to tracked files; "unknown" away from the
+/// source tree.
 pub fn revision() -> String {
+    match project_revision(None) {
+        Some((head, true)) => format!("{head}+"),
+        Some((head, false)) => head,
+        None => "unknown".into(),
+    }
+}
+
+/// The project's HEAD (12 hex digits) and whether tracked files differ from it, leaving out
+/// changes below `ignore` (e.g. the report's own output directory); None away from the source
+/// tree.
+pub fn project_revision(ignore: Option<&Path>) -> Option<(String, bool)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let git = |args: &[&str]| {
         Command::new("git")
@@ -51,14 +63,23 @@ pub fn revision() -> String {
             .output()
             .ok()
             .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_owned())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim_end().to_owned())
     };
-    match git(&["rev-parse", "--short=12", "HEAD"]) {
-        Some(head) => {
-            let dirty = git(&["status", "--porcelain", "--untracked-files=no"])
-                .is_some_and(|s| !s.is_empty());
-            if dirty { format!("{head}+") } else { head }
-        }
-        None => "unknown".into(),
-    }
+    let head = git(&["rev-parse", "--short=12", "HEAD"])?;
+    // The ignored directory as git names it (relative to the root); none when it lies outside
+    // the project, where every change counts.
+    let ignored = ignore.and_then(|dir| {
+        let (dir, root) = (dir.canonicalize().ok()?, root.canonicalize().ok()?);
+        let relative = dir.strip_prefix(&root).ok()?.to_string_lossy().into_owned();
+        (!relative.is_empty()).then(|| format!("{relative}/"))
+    });
+    let dirty = git(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| {
+        s.lines().any(|l| {
+            let path = l.get(3..).unwrap_or("");
+            ignored
+                .as_ref()
+                .is_none_or(|dir| !path.starts_with(dir.as_str()))
+        })
+    });
+    Some((head, dirty))
 }

@@ -12,9 +12,7 @@ use cdpr_analysis::metrics::Metrics;
 use cdpr_analysis::modes::{Analysis, Loop};
 use cdpr_core::closed_loop::ClosedLoop;
 use cdpr_core::model::{CableModel, ModelError};
-use cdpr_core::runner::{
-    Observer, Run, RunFailure, RunOptions, simulate as run_loop, simulate_observed as simulate_run,
-};
+use cdpr_core::runner::{Observer, Run, RunFailure, RunOptions, simulate_observed as simulate_run};
 use cdpr_core::scenario::{IntegratorKind, ModesChoice, Scenario, ScenarioError};
 use cdpr_core::trajectory::Step5;
 use cdpr_elastic::eq15_frequency;
@@ -55,8 +53,7 @@ pub fn simulate_observed(scenario: &Scenario, observer: &mut Observer) -> Result
 /// Simulates the scenario: the MODELS.md §2 initial state, then the scenario's integrator,
 /// sampled every sample period. `progress` receives the fraction of time done.
 pub fn simulate(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Run, Error> {
-    let mut sys = ClosedLoop::new(build(scenario)?, scenario);
-    Ok(run_loop(&mut sys, &RunOptions::from(scenario), progress)?)
+    simulate_observed(scenario, &mut Observer::progress(progress))
 }
 
 /// One model's run of a scenario, measured.
@@ -117,15 +114,7 @@ impl EndAnalysis {
 /// Simulates the scenario and measures it: metrics (§7) and, as `[analysis] modes` chooses, the
 /// settled end state, whose failure is reported, never fatal.
 pub fn assess(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Assessed, Error> {
-    let kind = ModelConfig::from_scenario(scenario)?.kind;
-    let run = simulate(scenario, progress)?;
-    Ok(Assessed {
-        kind,
-        metrics: metrics(scenario, &run),
-        end: end_analysis(scenario),
-        integrator: scenario.simulation.integrator,
-        run,
-    })
+    assess_observed(scenario, &mut Observer::progress(progress))
 }
 
 /// As [`assess`], watched and steered by `observer`.

@@ -371,39 +371,10 @@ fn write_figures(
 /// The git revision of the project this binary was built from (wherever it runs), marked when
 /// tracked files other than the report's own output differ.
 fn git_revision(out: &Path) -> String {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let run = |args: &[&str]| {
-        std::process::Command::new("git")
-            .arg("-C")
-            .arg(&root)
-            .args(args)
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim_end().to_owned())
-    };
-    let Some(rev) = run(&["rev-parse", "--short=12", "HEAD"]) else {
-        return "unknown (not a git checkout)".into();
-    };
-    // The output directory as git names it (relative to the project root); empty when it lies
-    // outside the project, where every change counts.
-    let out = match (out.canonicalize(), root.canonicalize()) {
-        (Ok(out), Ok(root)) => out
-            .strip_prefix(&root)
-            .map(|p| p.to_string_lossy().into_owned())
-            .unwrap_or_default(),
-        _ => String::new(),
-    };
-    let dirty = run(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| {
-        s.lines().any(|l| {
-            let path = l.get(3..).unwrap_or("");
-            out.is_empty() || !path.starts_with(&format!("{out}/"))
-        })
-    });
-    if dirty {
-        format!("{rev} (with uncommitted changes)")
-    } else {
-        rev
+    match cdpr_bench::project_revision(Some(out)) {
+        Some((head, true)) => format!("{head} (with uncommitted changes)"),
+        Some((head, false)) => head,
+        None => "unknown (not a git checkout)".into(),
     }
 }
 

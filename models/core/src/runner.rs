@@ -210,18 +210,25 @@ pub fn simulate<M: CableModel>(
     simulate_reusing(sys, opts, Vec::new(), progress)
 }
 
+/// The loop's MODELS.md §2 initial state, or the failure of a run that could not start.
+fn initial_state<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+) -> Result<(Vec<f64>, Equilibrium), Box<RunFailure>> {
+    sys.initial_state().map_err(|e| {
+        Box::new(RunFailure {
+            error: e.into(),
+            partial: None,
+        })
+    })
+}
+
 /// As [`simulate`], watched and steered by `observer`.
 pub fn simulate_observed<M: CableModel>(
     sys: &mut ClosedLoop<M>,
     opts: &RunOptions,
     observer: &mut Observer,
 ) -> Result<Run, Box<RunFailure>> {
-    let (y0, equilibrium) = sys.initial_state().map_err(|e| {
-        Box::new(RunFailure {
-            error: e.into(),
-            partial: None,
-        })
-    })?;
+    let (y0, equilibrium) = initial_state(sys)?;
     integrate_and_sample(sys, y0, equilibrium, opts, Vec::new(), observer)
 }
 
@@ -233,12 +240,7 @@ pub fn simulate_reusing<M: CableModel>(
     buffer: Vec<f64>,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Run, Box<RunFailure>> {
-    let (y0, equilibrium) = sys.initial_state().map_err(|e| {
-        Box::new(RunFailure {
-            error: e.into(),
-            partial: None,
-        })
-    })?;
+    let (y0, equilibrium) = initial_state(sys)?;
     integrate_and_sample(
         sys,
         y0,
