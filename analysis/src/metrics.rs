@@ -189,6 +189,17 @@ pub const UNITS: &[(&str, &str)] = &[
     ("wall_s", "s"),
 ];
 
+/// Peak memory [B] of a run of `samples` samples × `channels` channels and its metrics: the
+/// samples themselves (8 B each), the seven columns the metrics copy out, and the two refined
+/// spectra of the settled window (Hann, [`PAD`]× zero padding: a real input and its complex
+/// transform per padded sample). The spectra dominate: 2e7 samples of 22 channels need ~20 GB.
+pub fn memory_estimate(samples: f64, channels: usize) -> f64 {
+    let series = samples * channels as f64 * 8.0;
+    let columns = 7.0 * samples * 8.0;
+    let spectra = 2.0 * PAD as f64 * samples * (8.0 + 16.0);
+    series + columns + spectra
+}
+
 /// Index range of the samples with t in [a, b] (`include_end`) or [a, b), on a grid of period dt.
 fn window(t: &[f64], a: f64, b: f64, include_end: bool, dt: f64) -> std::ops::Range<usize> {
     let half = 0.5 * dt;

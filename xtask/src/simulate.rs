@@ -8,7 +8,7 @@
 
 use crate::output::{Progress, csv_row, write_json};
 use anyhow::{Context, Result, bail};
-use cdpr_bench::analysis::metrics::{Metrics, UNITS};
+use cdpr_bench::analysis::metrics::{Metrics, UNITS, memory_estimate};
 use cdpr_bench::core::runner::{Observer, RunError, channel_names};
 use cdpr_bench::core::scenario::Scenario;
 use cdpr_bench::{Assessed, EndAnalysis, Error, ModelConfig, ModelKind, Provenance};
@@ -95,30 +95,40 @@ pub fn prepare_out(out: &Path) -> Result<()> {
     File::create(&probe)
         .and_then(|_| std::fs::remove_file(&probe))
         .with_context(|| format!("--out {} is not writable", out.display()))?;
-    for name in [TIMESERIES, PARTIAL, METRICS] {
-        match std::fs::remove_file(out.join(name)) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(e).with_context(|| format!("removing {}", out.join(name).display()));
-            }
-            _ => {}
+    // An earlier run's outputs, and the temporary files of atomic writes a kill interrupted
+    // (`.metrics.json.tmp-PID`), which would otherwise accumulate.
+    let stale = |name: &str| {
+        [TIMESERIES, PARTIAL, METRICS].contains(&name)
+            || [TIMESERIES, METRICS]
+                .iter()
+                .any(|o| name.starts_with(&format!(".{o}.tmp-")))
+    };
+    let entries =
+        std::fs::read_dir(out).with_context(|| format!("reading --out {}", out.display()))?;
+    for entry in entries {
+        let entry = entry?;
+        if stale(&entry.file_name().to_string_lossy()) {
+            std::fs::remove_file(entry.path())
+                .with_context(|| format!("removing {}", entry.path().display()))?;
         }
     }
     Ok(())
 }
 
-/// Refuses a run whose samples (`channels` wide) would take more than [`MEMORY_SHARE`] of the
-/// available memory, naming the estimate and the keys that set it.
+/// Refuses a run whose samples (`channels` wide) and their metrics would take more than
+/// [`MEMORY_SHARE`] of the available memory, naming the estimate and the keys that set it.
 fn check_memory(scenario: &Scenario, channels: usize) -> Result<()> {
     let sim = &scenario.simulation;
     let samples = (sim.t_final / sim.sample_period).round() + 1.0;
-    let bytes = samples * channels as f64 * 8.0;
+    let bytes = memory_estimate(samples, channels);
     if let Some(available) = available_memory()
         && bytes > MEMORY_SHARE * available
     {
         bail!(
-            "the run's samples need {:.1} GB ({samples:e} samples × {channels} channels × 8 B), \
-             more than half of the {:.1} GB available: raise simulation.sample_period \
-             (now {} s) or shorten simulation.t_final (now {} s)",
+            "the run and its metrics need about {:.1} GB ({samples:e} samples of {channels} \
+             channels, their columns and 16×-padded spectra), more than half of the {:.1} GB \
+             available: raise simulation.sample_period (now {} s) or shorten \
+             simulation.t_final (now {} s)",
             bytes / 1e9,
             available / 1e9,
             sim.sample_period,

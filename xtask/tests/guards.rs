@@ -189,6 +189,8 @@ fn out_is_checked_first_and_stale_outputs_are_removed() {
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(out.join("metrics.json"), "{\"status\": \"an earlier run\"}").unwrap();
     std::fs::write(out.join("timeseries.csv"), "t\n0\n").unwrap();
+    // A killed atomic write's temporary file.
+    std::fs::write(out.join(".metrics.json.tmp-99999"), "{").unwrap();
     // A cable that goes slack: the run fails at once.
     let slack = scenario_file(
         &dir,
@@ -204,6 +206,53 @@ fn out_is_checked_first_and_stale_outputs_are_removed() {
     assert!(m["error"].as_str().unwrap().contains("slack"));
     let csv = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
     assert!(csv.starts_with("t,x_ref,"), "the new run's partial series");
+    assert!(
+        !out.join(".metrics.json.tmp-99999").exists(),
+        "stale temporary file kept"
+    );
+}
+
+/// MemAvailable of /proc/meminfo [B].
+fn available_memory() -> f64 {
+    let info = std::fs::read_to_string("/proc/meminfo").unwrap();
+    let line = info
+        .lines()
+        .find(|l| l.starts_with("MemAvailable:"))
+        .unwrap();
+    line.split_whitespace()
+        .nth(1)
+        .unwrap()
+        .parse::<f64>()
+        .unwrap()
+        * 1024.0
+}
+
+/// The smallest sample period the scenario allows (2e7 samples over 5 s) needs about 19 GB for
+/// the samples, their columns and the padded spectra: more than half of this 24 GB machine, so
+/// the run is refused before it starts, with the estimate and the key to change.
+#[test]
+fn a_run_that_would_exhaust_memory_is_refused_before_it_starts() {
+    let dir = TempDir::new("memory");
+    let scenario = scenario_file(&dir, "fine.toml", "[simulation]\nsample_period = 2.5e-7\n");
+    let samples = 2e7 + 1.0;
+    let estimate = cdpr_bench::analysis::metrics::memory_estimate(samples, 18);
+    assert!(estimate > 1.9e10, "{estimate}");
+    if estimate <= 0.5 * available_memory() {
+        eprintln!("this machine has room for the run: nothing to refuse");
+        return;
+    }
+    let started = Instant::now();
+    let output = simulate(&scenario, &dir.join("out"));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("simulation.sample_period") && stderr.contains("GB"),
+        "{stderr}"
+    );
+    assert!(
+        started.elapsed() < Duration::from_secs(5),
+        "refused before the run"
+    );
 }
 
 /// Spawns the FE paper run (DOPRI5, ~10 s) and waits until it has streamed samples.
