@@ -73,6 +73,44 @@ proptest! {
 }
 
 proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// At finite sag (the paper's 2.3° to 10° at mid-span) the geometric vertical frequency is
+    /// √(Σ T_i cos²θ_i / (M l_i)), θ_i each cable's angle below the horizontal, written here from
+    /// the equilibrium's geometry (MODELS.md §3), not from the model's unit vectors: 1e-12
+    /// relative (round-off of two angles). Dropping cos²θ errs by θ² ≥ 1.6e-3 here. As the sag
+    /// vanishes it is eq. 15 (the test above).
+    #[test]
+    fn vertical_frequency_at_finite_sag_has_cos2(
+        frac in 0.15f64..0.85,
+        mass in 0.3f64..3.0,
+        tension_sum in 60.0f64..600.0,
+        sag_degrees in 2.3f64..10.0,
+    ) {
+        let d = 1.0;
+        // M g = ΣT sin θ at mid-span sets the sag angle.
+        let g = tension_sum * sag_degrees.to_radians().sin() / mass;
+        let mut m = model(d, mass, g);
+        let x = frac * d;
+        let eq = m.equilibrium(x, tension_sum).unwrap();
+        let z = eq.state[1];
+        let tensions = [0.5 * (tension_sum - eq.force), 0.5 * (tension_sum + eq.force)];
+        let stiffness: f64 = [x, d - x]
+            .into_iter()
+            .zip(tensions)
+            .map(|(horizontal, t)| {
+                let theta = (-z).atan2(horizontal);
+                t * theta.cos().powi(2) / horizontal.hypot(z)
+            })
+            .sum();
+        let expected = (stiffness / mass).sqrt();
+        let geometric = m.vertical_frequency(Vector2::new(x, z), tensions);
+        prop_assert!((geometric / expected - 1.0).abs() < 1e-12, "{geometric} vs {expected}");
+        prop_assert!(-z / x.min(d - x) > 0.035, "the sag is finite: z = {z}");
+    }
+}
+
+proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 
     /// PID off, constant tensions: E = ½M|v|² + M g z + T1 l1 + T2 l2 is a first integral
