@@ -4,7 +4,7 @@
 //! ([`ode`]), Dormand–Prince 5(4) ([`dopri5`]), generalised-α ([`generalized_alpha`]), the
 //! refactorising sparse LU of its iteration matrix ([`sparse`]), Newton's method for square
 //! nonlinear systems ([`newton`]), finite differences ([`differences`]), eigen-analysis
-//! ([`eigen`]) and lane norms ([`norms`]). faer lives here and nowhere else in the library.
+//! ([`eigen`]), the Riccati equation of LQR design ([`riccati`]) and lane norms ([`norms`]). faer lives here and nowhere else in the library.
 //!
 //! # Examples
 //!
@@ -39,6 +39,7 @@ pub mod generalized_alpha;
 pub mod newton;
 pub mod norms;
 pub mod ode;
+pub mod riccati;
 pub mod sparse;
 
 pub use dopri5::{Dopri5, Dopri5Options};
