@@ -4,7 +4,8 @@
 //! ([`ode`]), Dormand–Prince 5(4) ([`dopri5`]), generalised-α ([`generalized_alpha`]), the
 //! refactorising sparse LU of its iteration matrix ([`sparse`]), Newton's method for square
 //! nonlinear systems ([`newton`]), finite differences ([`differences`]), eigen-analysis
-//! ([`eigen`]), the Riccati equation of LQR design ([`riccati`]) and lane norms ([`norms`]). faer lives here and nowhere else in the library.
+//! ([`eigen`]), the Riccati equation of LQR design ([`riccati`]) and lane norms ([`norms`]).
+//! faer lives here and nowhere else in the library.
 //!
 //! # Examples
 //!
