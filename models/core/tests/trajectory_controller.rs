@@ -296,3 +296,85 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// The implicit path's PID update (MODELS.md FE.9.3) is the trapezoidal rule of the PID's own
+    /// state equations: w_{n+1} − w_n = h (e_n + e_{n+1})/2 and f_{n+1} − f_n = h (f'_n + f'_{n+1})/2
+    /// with f' = N_f (e − f) from `state_rate`, to round-off (1e-12 of the terms), for any step,
+    /// stiff (h N_f up to 1e3) or not.
+    #[test]
+    fn trapezoidal_step_is_the_trapezoidal_rule_of_the_state_equations(
+        nf in 1.0f64..1e4,
+        h in 1e-6f64..0.1,
+        w0 in -1.0f64..1.0,
+        f0 in -1e-2f64..1e-2,
+        e0 in -1e-2f64..1e-2,
+        e1 in -1e-2f64..1e-2,
+    ) {
+        let pid = Pid { p: 1.0, i: 1.0, d: 1.0, filter: nf };
+        let start = PidState { integral: w0, filter: f0 };
+        let end = pid.trapezoidal_step(start, e0, e1, h);
+        let (r0, r1) = (pid.state_rate(e0, start), pid.state_rate(e1, end));
+        let scale = h * (e0.abs() + e1.abs()) + 1e-300;
+        prop_assert!((end.integral - w0 - 0.5 * h * (r0.integral + r1.integral)).abs() <= 1e-12 * (w0.abs() + scale));
+        let filter_terms = f0.abs() + 0.5 * h * (r0.filter.abs() + r1.filter.abs()) + 1e-300;
+        prop_assert!(
+            (end.filter - f0 - 0.5 * h * (r0.filter + r1.filter)).abs() <= 1e-12 * filter_terms,
+            "f: {} − {} vs h/2 ({} + {})", end.filter, f0, r0.filter, r1.filter
+        );
+    }
+}
+
+/// Second order, A-stable: for a ramp error e = a + b t the filter state f' = N_f (e − f) has
+/// the closed form f = e − b/N_f + (f0 − a + b/N_f) e^(−N_f t); n trapezoidal steps to T = 5 ms
+/// (N_f T = 2.7, while the transient still dominates) err by O(h²), so halving h divides the
+/// error by 4 (3.8–4.2, the next term's share); the
+/// integral is exact for a linear error (1e-14). With h N_f = 1e3 the filter state stays
+/// bounded by its start and the error (no growth of a stiff pole).
+#[test]
+fn trapezoidal_step_is_second_order_and_a_stable() {
+    let nf = 540.0;
+    let pid = Pid {
+        p: 1.0,
+        i: 1.0,
+        d: 1.0,
+        filter: nf,
+    };
+    let (a, b, f0, t_end) = (1e-3, 0.05, -2e-3, 5e-3);
+    let error = |t: f64| a + b * t;
+    let exact = error(t_end) - b / nf + (f0 - a + b / nf) * (-nf * t_end).exp();
+    let run = |steps: usize| {
+        let h = t_end / steps as f64;
+        let mut s = PidState {
+            integral: 0.0,
+            filter: f0,
+        };
+        for k in 0..steps {
+            s = pid.trapezoidal_step(s, error(k as f64 * h), error((k + 1) as f64 * h), h);
+        }
+        s
+    };
+    let (coarse, fine) = (run(20), run(40));
+    let ratio = (coarse.filter - exact).abs() / (fine.filter - exact).abs();
+    assert!((3.8..4.2).contains(&ratio), "error ratio {ratio}");
+    let integral = a * t_end + 0.5 * b * t_end * t_end;
+    assert!(
+        (fine.integral - integral).abs() < 1e-14,
+        "{}",
+        fine.integral
+    );
+    let mut s = PidState {
+        integral: 0.0,
+        filter: 1.0,
+    };
+    for _ in 0..100 {
+        s = pid.trapezoidal_step(s, 0.5, 0.5, 1e3 / nf);
+        assert!(
+            s.filter.abs() <= 1.0 + 1e-12,
+            "stiff step grew: {}",
+            s.filter
+        );
+    }
+}
