@@ -96,28 +96,20 @@ pub fn care(a: &Mat<f64>, b: &Mat<f64>, q: &Mat<f64>, r: &Mat<f64>) -> Result<Ca
     if !finite(&x) {
         return Err(RiccatiError::NotStabilisable);
     }
+    // The residual's round-off scale: the largest terms of the equation.
+    let scale = |x: &Mat<f64>| 1.0 + max_abs(q) + max_abs(x) * (1.0 + max_abs(a));
     let mut iterations = 0;
     loop {
-        let gain = &r_inv * b.transpose() * &x;
         let residual = residual(a, &s, q, &x);
-        let scale = 1.0 + max_abs(q) + max_abs(&x) * (1.0 + max_abs(a));
-        if residual <= 1e-13 * scale || iterations == MAX_ITERATIONS {
-            if residual > 1e-8 * scale {
+        let converged = residual <= 1e-13 * scale(&x);
+        if converged || iterations == MAX_ITERATIONS {
+            if !converged && residual > 1e-8 * scale(&x) {
                 return Err(RiccatiError::NotConverged {
                     residual,
                     iterations,
                 });
             }
-            return stabilising(
-                a,
-                &s,
-                Care {
-                    x,
-                    gain,
-                    residual,
-                    iterations,
-                },
-            );
+            break;
         }
         // Newton–Kleinman: (A − S X)ᵀ X⁺ + X⁺ (A − S X) = −(Q + X S X).
         let closed = a - &s * &x;
@@ -130,21 +122,16 @@ pub fn care(a: &Mat<f64>, b: &Mat<f64>, q: &Mat<f64>, r: &Mat<f64>) -> Result<Ca
         x = symmetrised(&next);
         iterations += 1;
         if change <= 1e-15 * (1.0 + max_abs(&x)) {
-            // At round-off: one more pass evaluates the residual and returns.
-            let residual = self::residual(a, &s, q, &x);
-            let gain = &r_inv * b.transpose() * &x;
-            return stabilising(
-                a,
-                &s,
-                Care {
-                    x,
-                    gain,
-                    residual,
-                    iterations,
-                },
-            );
+            break; // at round-off
         }
     }
+    let care = Care {
+        gain: &r_inv * b.transpose() * &x,
+        residual: residual(a, &s, q, &x),
+        x,
+        iterations,
+    };
+    stabilising(a, &s, care)
 }
 
 /// `care` if A − S X has every eigenvalue in the open left half-plane.

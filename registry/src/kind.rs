@@ -60,6 +60,9 @@ impl std::str::FromStr for ModelKind {
         Self::ALL
             .into_iter()
             .find(|k| k.name() == s)
-            .ok_or_else(|| format!("unknown model `{s}`: allowed elastic, lumped, fe"))
+            .ok_or_else(|| {
+                let allowed: Vec<_> = Self::ALL.map(Self::name).into();
+                format!("unknown model `{s}`: allowed {}", allowed.join(", "))
+            })
     }
 }

@@ -404,13 +404,9 @@ fn draw_panel<DB: DrawingBackend>(
         let variation: f64 = l.points.windows(2).map(|p| (p[1].1 - p[0].1).abs()).sum();
         variation.max(f64::MIN_POSITIVE).log2().floor()
     };
-    let mut order: Vec<&Line> = panel.lines.iter().collect();
-    order.sort_by(|a, b| {
-        roughness(b)
-            .total_cmp(&roughness(a))
-            .then(b.width.total_cmp(&a.width))
-    });
-    for line in order {
+    let mut order: Vec<(f64, &Line)> = panel.lines.iter().map(|l| (roughness(l), l)).collect();
+    order.sort_by(|(ra, a), (rb, b)| rb.total_cmp(ra).then(b.width.total_cmp(&a.width)));
+    for (_, line) in order {
         let style = line
             .color
             .mix(LINE_OPACITY)

@@ -6,8 +6,9 @@
 use crate::output::Progress;
 use crate::simulate::{load_scenario, model_kind};
 use anyhow::{Result, bail};
-use cdpr_bench::ModelKind;
+use cdpr_bench::core::model::CableModel;
 use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::{ModelKind, ModelVisitor};
 use std::path::Path;
 
 /// An interval [min, max] sampled at the midpoints of `steps` equal cells.
@@ -57,22 +58,42 @@ pub fn sweep(
     tension_sum: Axis,
     progress: &mut dyn FnMut(f64),
 ) -> Result<(Vec<Failure>, usize)> {
-    let mut failures = Vec::new();
-    for i in 0..x.steps {
-        for j in 0..tension_sum.steps {
-            let (at, sum) = (x.at(i), tension_sum.at(j));
-            // A fresh model per start: the lumped model's stored/free split is part of its state.
-            let mut model = cdpr_bench::build(scenario)?;
-            if let Err(e) = model.equilibrium(at, sum) {
-                failures.push(Failure {
-                    x: at,
-                    tension_sum: sum,
-                    why: e.to_string(),
-                });
-            }
-        }
-        progress((i + 1) as f64 / x.steps as f64);
+    /// The grid on the scenario's model, built (and its scenario checked) once.
+    struct Grid<'a> {
+        x: Axis,
+        tension_sum: Axis,
+        progress: &'a mut dyn FnMut(f64),
     }
+    impl ModelVisitor for Grid<'_> {
+        type Output = Vec<Failure>;
+        fn visit<M: CableModel + Clone + Send + 'static>(self, built: M) -> Vec<Failure> {
+            let mut failures = Vec::new();
+            for i in 0..self.x.steps {
+                for j in 0..self.tension_sum.steps {
+                    let (at, sum) = (self.x.at(i), self.tension_sum.at(j));
+                    // A fresh copy per start: the lumped model's stored/free split is part of
+                    // its state, and an equilibrium changes it.
+                    if let Err(e) = built.clone().equilibrium(at, sum) {
+                        failures.push(Failure {
+                            x: at,
+                            tension_sum: sum,
+                            why: e.to_string(),
+                        });
+                    }
+                }
+                (self.progress)((i + 1) as f64 / self.x.steps as f64);
+            }
+            failures
+        }
+    }
+    let failures = cdpr_bench::with_model(
+        scenario,
+        Grid {
+            x,
+            tension_sum,
+            progress,
+        },
+    )?;
     Ok((failures, x.steps * tension_sum.steps))
 }
 

@@ -54,8 +54,22 @@ impl Default for Params {
 
 impl ModelParams for Params {
     type Model = crate::Fe;
+    /// MODELS.md §9: the modelled cable covers the free span the trajectory needs with a stored
+    /// length of at least 5 % of it left at all times.
     fn validate(&self, scenario: &Scenario) -> Result<(), ScenarioError> {
-        self.validate(scenario)
+        let (free, chord) = scenario.free_length_needed();
+        let l0 = scenario.cable.modelled_length;
+        let needed = free / 0.95;
+        if l0 < needed {
+            return Err(out_of_range(
+                "cable.modelled_length",
+                l0,
+                format!(
+                    "≥ {needed:.6} m for this trajectory (1.05 × (1 + ΣT/EA) × longest chord {chord:.6} m, plus a stored length ≥ 5 % of it)"
+                ),
+            ));
+        }
+        Ok(())
     }
     fn build(&self, scenario: &Scenario) -> Result<crate::Fe, ModelError> {
         crate::Fe::new(scenario, *self)
@@ -75,23 +89,5 @@ impl Params {
             mass,
             stored,
         })
-    }
-
-    /// MODELS.md §9: the modelled cable covers the free span the trajectory needs with a stored
-    /// length of at least 5 % of it left at all times.
-    pub fn validate(&self, scenario: &Scenario) -> Result<(), ScenarioError> {
-        let (free, chord) = scenario.free_length_needed();
-        let l0 = scenario.cable.modelled_length;
-        let needed = free / 0.95;
-        if l0 < needed {
-            return Err(out_of_range(
-                "cable.modelled_length",
-                l0,
-                format!(
-                    "≥ {needed:.6} m for this trajectory (1.05 × (1 + ΣT/EA) × longest chord {chord:.6} m, plus a stored length ≥ 5 % of it)"
-                ),
-            ));
-        }
-        Ok(())
     }
 }

@@ -27,8 +27,32 @@ impl Default for Params {
 
 impl ModelParams for Params {
     type Model = crate::Lumped;
+    /// At least [`MIN_ELEMENTS`] springs, and (MODELS.md §9) the modelled cable covers the free
+    /// span the trajectory needs plus two spare stored elements, so a node is always left on the
+    /// reel.
     fn validate(&self, scenario: &Scenario) -> Result<(), ScenarioError> {
-        self.validate(scenario)
+        if self.elements < MIN_ELEMENTS {
+            return Err(out_of_range(
+                "model.elements",
+                self.elements,
+                format!(
+                    "an integer ≥ {MIN_ELEMENTS} for the lumped model (a reel end, a straddling spring, a free node)"
+                ),
+            ));
+        }
+        let (free, chord) = scenario.free_length_needed();
+        let l0 = scenario.cable.modelled_length;
+        let needed = free + 2.0 * l0 / self.elements as f64;
+        if l0 < needed {
+            return Err(out_of_range(
+                "cable.modelled_length",
+                l0,
+                format!(
+                    "≥ {needed:.6} m for this trajectory (1.05 × (1 + ΣT/EA) × longest chord {chord:.6} m, plus two spare stored elements)"
+                ),
+            ));
+        }
+        Ok(())
     }
     fn build(&self, scenario: &Scenario) -> Result<crate::Lumped, ModelError> {
         crate::Lumped::new(scenario, *self)
@@ -42,33 +66,5 @@ impl Params {
         Ok(Self {
             elements: count_in_range("model.elements", elements, DEFAULT_ELEMENTS)?,
         })
-    }
-
-    /// At least [`MIN_ELEMENTS`] springs, and (MODELS.md §9) the modelled cable covers the free
-    /// span the trajectory needs plus two spare stored elements, so a node is always left on the
-    /// reel.
-    pub fn validate(&self, scenario: &Scenario) -> Result<(), ScenarioError> {
-        if self.elements < MIN_ELEMENTS {
-            return Err(out_of_range(
-                "model.elements",
-                self.elements,
-                format!(
-                    "an integer ≥ {MIN_ELEMENTS} for the lumped model (a reel end, a straddling spring, a free node)"
-                ),
-            ));
-        }
-        let (free, chord) = scenario.free_length_needed();
-        let l0 = scenario.cable.modelled_length;
-        let needed = free + 2.0 * l0 / self.elements.max(1) as f64;
-        if l0 < needed {
-            return Err(out_of_range(
-                "cable.modelled_length",
-                l0,
-                format!(
-                    "≥ {needed:.6} m for this trajectory (1.05 × (1 + ΣT/EA) × longest chord {chord:.6} m, plus two spare stored elements)"
-                ),
-            ));
-        }
-        Ok(())
     }
 }
