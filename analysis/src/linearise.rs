@@ -1,5 +1,5 @@
 //! Linearisation of the closed loop about its rest state at an effector position: the
-//! fourth-order finite-difference Jacobian of model + PID + tension distribution
+//! fourth-order finite-difference Jacobian of model + controller + tension limits
 //! (`cdpr_numerics::differences::jacobian_within`), the coordinates a constraint holds fixed
 //! dropped ([`cdpr_numerics::eigen::reduce`]), and every eigenpair classified
 //! ([`crate::modes::classify`]).
@@ -26,14 +26,14 @@ use faer::Mat;
 /// Jacobian ∂y'/∂y of the closed loop (model and PID states; the audit states are left out) at
 /// (t, y) by central differences ([`jacobian`] for the step rule).
 pub fn closed_loop_jacobian<M: CableModel>(sys: &mut ClosedLoop<M>, t: f64, y: &[f64]) -> Mat<f64> {
-    let n = sys.model_len() + 2;
+    let n = sys.dynamic_len();
     jacobian(sys, t, y, n)
 }
 
 /// A linearisation with the raw eigenvectors kept (for perturbing a nonlinear run along a mode).
 pub struct Linearised {
     pub analysis: Analysis,
-    /// Closed-loop state of the equilibrium (model | w | f | W | D).
+    /// Closed-loop state of the equilibrium (model | controller | W | D).
     pub state: Vec<f64>,
     /// For each mode of `analysis.modes` (same order), its eigenvector mapped back to the model and
     /// PID states of `state` (zeros on frozen coordinates and, open loop, on the PID states).
@@ -49,7 +49,11 @@ pub fn linearise<M: CableModel>(
     feedback: Loop,
 ) -> Result<Linearised, AnalysisError> {
     let mut sys = ClosedLoop::new(model, scenario);
-    check_size(sys.model_len() + 2)?;
+    check_size(sys.dynamic_len())?;
+    if sys.controller.kind().acts_on_z() {
+        // The held height z0 is the start equilibrium's.
+        sys.initial_state()?;
+    }
     // Hold the reference at x: the loop is then autonomous and x is its equilibrium.
     sys.trajectory = Step5 {
         x1: x,
@@ -57,7 +61,7 @@ pub fn linearise<M: CableModel>(
         ..sys.trajectory
     };
     let (y, eq) = sys.rest_state(x)?;
-    let tensions = sys.distribution.tensions(eq.force);
+    let tensions = sys.rest_tensions();
     if feedback == Loop::Open {
         sys.actuation = Actuation::Prescribed(Box::new(move |_| tensions));
     }
@@ -70,26 +74,27 @@ pub fn linearise<M: CableModel>(
         .copied()
         .chain(free.iter().map(|i| np + i))
         .collect();
+    let m = sys.dynamic_len();
     if feedback == Loop::Closed {
-        keep.extend([n, n + 1]);
+        keep.extend(n..m);
     }
     // The stencil stays where the forces are smooth, as the models' own iteration matrices do:
     // on fine meshes the springs' stretch falls below the default reach (lumped N = 200 at
     // x = 0.5: ≈ 2.8e-6 m against 3e-6·|x|) and the slack side under-reads the axial stiffness.
-    let mut reach = vec![f64::INFINITY; n + 2];
+    let mut reach = vec![f64::INFINITY; m];
     if let Some(form) = sys.model.second_order() {
         form.smooth_reach(&y[..n], &mut reach[..np]);
     }
     // Velocities at rest: a step scale of 1 m/s (the step5 peak speed is 0.94 m/s), see
     // `cdpr_numerics::differences::jacobian_within`.
-    let mut scale = vec![1e-3; n + 2];
+    let mut scale = vec![1e-3; m];
     scale[np..n].fill(1.0);
-    let jac = jacobian_within(&mut sys, 0.0, &y, n + 2, &reach, &scale);
+    let jac = jacobian_within(&mut sys, 0.0, &y, m, &reach, &scale);
     let shapes = mode_shapes(&reduce(&jac, &keep))?;
     let mut modes = Vec::with_capacity(shapes.len());
     let mut vectors = Vec::with_capacity(shapes.len());
     for shape in &shapes {
-        let mut full = vec![(0.0, 0.0); n + 2];
+        let mut full = vec![(0.0, 0.0); m];
         for (k, &i) in keep.iter().enumerate() {
             full[i] = shape.vector[k];
         }
@@ -152,12 +157,12 @@ pub struct EndState {
 }
 
 /// [`EndState`] of `sys` at the trajectory's x2: the closed-loop mode nearest `omega_guess`
-/// [rad/s], from the finite-difference Jacobian of model + PID + tension distribution.
+/// [rad/s], from the finite-difference Jacobian of model + controller.
 pub fn end_state<M: CableModel>(
     mut sys: ClosedLoop<M>,
     omega_guess: f64,
 ) -> Result<EndState, AnalysisError> {
-    check_size(sys.model_len() + 2)?;
+    check_size(sys.dynamic_len())?;
     let (y, eq) = sys.rest_state(sys.trajectory.x2)?;
     // After t2 the reference is constant: the loop is autonomous there.
     let t = sys.trajectory.t2 + 1.0;

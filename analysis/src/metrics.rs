@@ -7,6 +7,7 @@
 //! window the run does not reach, or is too short for, is NaN (null in `metrics.json`) and
 //! [`Metrics::unavailable`] says why. [`UNITS`] and the field docs below are the definitions.
 
+use crate::control_metrics::{ControlContext, ControlMetrics};
 use crate::spectrum::{Peak, Spectrum, Window};
 use cdpr_core::channel::Channel;
 use cdpr_core::runner::Run;
@@ -138,6 +139,9 @@ pub struct Metrics {
     pub factorisations: u64,
     pub pivotings: u64,
     pub wall_s: f64,
+    /// The vibration-control metrics.
+    #[serde(flatten)]
+    pub control: ControlMetrics,
 }
 
 /// The unit of every key of [`Metrics`] as `metrics.json` writes it ("" for counts and names;
@@ -187,6 +191,17 @@ pub const UNITS: &[(&str, &str)] = &[
     ("factorisations", ""),
     ("pivotings", ""),
     ("wall_s", "s"),
+    ("controller", ""),
+    ("path_err_max_transition", "m"),
+    ("ex_max_transition", "m"),
+    ("ez_max_transition", "m"),
+    ("x_settle_s", "s"),
+    ("z_settle_s", "s"),
+    ("tension_min", "N"),
+    ("tension_max", "N"),
+    ("saturated_s", "s"),
+    ("least_stable_growth", "1/s"),
+    ("controller_gains", "SI"),
 ];
 
 /// Peak memory [B] of a run of `samples` samples × `channels` channels and its metrics: the
@@ -256,8 +271,9 @@ impl SettledSpectra {
 }
 
 impl Metrics {
-    /// Computes every metric of `run` sampled every `dt` [s] on the trajectory `step5`.
-    pub fn from_run(run: &Run, step5: &Step5, dt: f64) -> Self {
+    /// Computes every metric of `run` sampled every `dt` [s] on the trajectory `step5`, with
+    /// the controller's `context`.
+    pub fn from_run(run: &Run, step5: &Step5, dt: f64, context: &ControlContext) -> Self {
         let s = &run.series;
         // Every run has the common channels; an empty record gives empty columns.
         let col = |channel: Channel| s.column(channel).unwrap_or_default();
@@ -362,6 +378,7 @@ impl Metrics {
             factorisations: run.stats.factorisations,
             pivotings: run.stats.pivotings,
             wall_s: run.wall_s,
+            control: ControlMetrics::from_run(run, context),
         };
         metrics.mark_unavailable();
         metrics

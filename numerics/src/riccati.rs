@@ -146,6 +146,36 @@ fn stabilising(a: &Mat<f64>, s: &Mat<f64>, care: Care) -> Result<Care, RiccatiEr
     }
 }
 
+/// The LQR gain of a CARE given as row-major slices, for callers that do not use faer: A (n × n),
+/// B (n × m), Q (n × n), R (m × m). Returns K (m × n, row-major) with [`Care`]'s residual and
+/// iteration count.
+pub fn lqr_gain(
+    n: usize,
+    m: usize,
+    a: &[f64],
+    b: &[f64],
+    q: &[f64],
+    r: &[f64],
+) -> Result<(Vec<f64>, f64, usize), RiccatiError> {
+    if a.len() != n * n || b.len() != n * m || q.len() != n * n || r.len() != m * m {
+        return Err(RiccatiError::Dimensions(format!(
+            "A {} B {} Q {} R {} values for n = {n}, m = {m}",
+            a.len(),
+            b.len(),
+            q.len(),
+            r.len()
+        )));
+    }
+    let mat =
+        |v: &[f64], rows: usize, cols: usize| Mat::from_fn(rows, cols, |i, j| v[i * cols + j]);
+    let care = care(&mat(a, n, n), &mat(b, n, m), &mat(q, n, n), &mat(r, m, m))?;
+    let gain = (0..m)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .map(|(i, j)| care.gain[(i, j)])
+        .collect();
+    Ok((gain, care.residual, care.iterations))
+}
+
 /// max |Aᵀ X + X A − X S X + Q| with S = B R⁻¹ Bᵀ.
 pub fn residual(a: &Mat<f64>, s: &Mat<f64>, q: &Mat<f64>, x: &Mat<f64>) -> f64 {
     max_abs(&(a.transpose() * x + x * a - x * s * x + q))

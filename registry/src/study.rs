@@ -6,11 +6,13 @@ use crate::build::{BuildError, ModelVisitor, build, with_model};
 use crate::config::ModelConfig;
 use crate::kind::ModelKind;
 use cdpr_analysis::AnalysisError;
+use cdpr_analysis::control_metrics::ControlContext;
 use cdpr_analysis::damping::{self, Sweep};
 use cdpr_analysis::linearise::{self, EndState, Linearised};
 use cdpr_analysis::metrics::Metrics;
 use cdpr_analysis::modes::{Analysis, Loop};
 use cdpr_core::closed_loop::ClosedLoop;
+use cdpr_core::controller::TensionLimits;
 use cdpr_core::model::{CableModel, ModelError};
 use cdpr_core::runner::{Observer, Run, RunFailure, RunOptions, simulate_observed as simulate_run};
 use cdpr_core::scenario::{IntegratorKind, ModesChoice, Scenario, ScenarioError};
@@ -121,10 +123,13 @@ pub fn assess(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Asse
 pub fn assess_observed(scenario: &Scenario, observer: &mut Observer) -> Result<Assessed, Error> {
     let kind = ModelConfig::from_scenario(scenario)?.kind;
     let run = simulate_observed(scenario, observer)?;
+    let (end, least_stable_growth) = end_analysis_and_growth(scenario);
+    let mut metrics = metrics(scenario, &run);
+    metrics.control.least_stable_growth = least_stable_growth;
     Ok(Assessed {
         kind,
-        metrics: metrics(scenario, &run),
-        end: end_analysis(scenario),
+        metrics,
+        end,
         integrator: scenario.simulation.integrator,
         run,
     })
@@ -148,29 +153,65 @@ impl Assessed {
 
 /// The end state as `[analysis] modes` chooses, its size limit and failure turned into notes.
 pub fn end_analysis(scenario: &Scenario) -> EndAnalysis {
+    end_analysis_and_growth(scenario).0
+}
+
+/// [`end_analysis`] and the largest growth rate of the closed loop's modes at x2 [1/s], from
+/// the modal analysis that drops the frozen coordinates ([`analyse`]; NaN where it was not
+/// done or failed). A loop without an oscillatory mode near eq. 15 (a z loop that over-damps
+/// it) fails the end state but still has its growth rate.
+pub fn end_analysis_and_growth(scenario: &Scenario) -> (EndAnalysis, f64) {
     if scenario.analysis.modes == ModesChoice::Off {
-        return EndAnalysis::Skipped {
-            reason: "[analysis] modes = \"off\"".into(),
-        };
+        let reason = "[analysis] modes = \"off\"".into();
+        return (EndAnalysis::Skipped { reason }, f64::NAN);
     }
-    match end_state(scenario) {
+    let end = match end_state(scenario) {
         Ok(end) => EndAnalysis::Done(end),
-        Err(Error::Analysis(e @ AnalysisError::TooLarge { .. })) => EndAnalysis::Skipped {
-            reason: e.to_string(),
-        },
+        Err(Error::Analysis(e @ AnalysisError::TooLarge { .. })) => {
+            let reason = e.to_string();
+            return (EndAnalysis::Skipped { reason }, f64::NAN);
+        }
         Err(e) => EndAnalysis::Failed {
             reason: e.to_string(),
         },
-    }
+    };
+    let growth = analyse(scenario, scenario.trajectory.x2, Loop::Closed)
+        .ok()
+        .and_then(|a| a.modes.iter().map(|m| m.mode.growth).reduce(f64::max))
+        .unwrap_or(f64::NAN);
+    (end, growth)
 }
 
-/// Metrics of a run of `scenario` (MODELS.md §7).
+/// Metrics of a run of `scenario` (MODELS.md §7 and the vibration-control metrics).
 pub fn metrics(scenario: &Scenario, run: &Run) -> Metrics {
-    Metrics::from_run(
-        run,
-        &Step5::from(&scenario.trajectory),
-        scenario.simulation.sample_period,
-    )
+    let step5 = Step5::from(&scenario.trajectory);
+    let context = ControlContext {
+        controller: scenario.controller.kind.name(),
+        move_start: step5.t1,
+        move_end: step5.t2,
+        limits: TensionLimits::from(&scenario.controller),
+        sample_period: scenario.simulation.sample_period,
+    };
+    let mut metrics = Metrics::from_run(run, &step5, scenario.simulation.sample_period, &context);
+    metrics.control.controller_gains = controller_gains(scenario);
+    metrics
+}
+
+/// The gains the scenario's controller designs for itself (the LQR's K at the start
+/// equilibrium's height), by name; empty where there are none or the design failed.
+pub fn controller_gains(scenario: &Scenario) -> std::collections::BTreeMap<String, Vec<f64>> {
+    let Ok(model) = build(scenario) else {
+        return Default::default();
+    };
+    let mut sys = ClosedLoop::new(model, scenario);
+    if sys.initial_state().is_err() {
+        return Default::default();
+    }
+    sys.controller
+        .gains()
+        .into_iter()
+        .map(|(name, values)| (name.to_owned(), values))
+        .collect()
 }
 
 /// The static equilibrium at x2 and the closed-loop mode nearest eq. 15 there (the effector's

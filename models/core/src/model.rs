@@ -23,6 +23,9 @@ pub enum ModelError {
     /// The static equilibrium of MODELS.md §2 was not found.
     #[error("static equilibrium not found: {0}")]
     Equilibrium(#[from] cdpr_numerics::newton::NewtonError),
+    /// The controller could not be designed for the loop's rest point.
+    #[error(transparent)]
+    Control(#[from] crate::controller::ControlError),
     /// The state left the model's domain (e.g. a node ordering the pulley rule forbids).
     #[error("invalid model state at t = {t} s: {why}")]
     State { t: f64, why: String },

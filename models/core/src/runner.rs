@@ -301,7 +301,7 @@ fn integrate_and_sample<M: CableModel>(
             dopri = Dopri5::new(
                 y0.len(),
                 Dopri5Options {
-                    norm_components: Some(n + 2),
+                    norm_components: Some(sys.dynamic_len()),
                     ..opts.dopri
                 },
             );
@@ -546,7 +546,8 @@ impl Sampler {
             let model_state = &y[..n];
             let eff = sys.model.effector(model_state);
             let energy = sys.model.energy(model_state);
-            let (work, dissipated) = (y[n + 2], y[n + 3]);
+            let c = n + sys.controller_len();
+            let (work, dissipated) = (y[c], y[c + 1]);
             let residual = energy.total() - self.energy0 - work + dissipated - self.event_energy;
             let m = self.model_channels;
             self.series.push_row_with(|row| {

@@ -16,8 +16,10 @@ pub trait SecondOrderForm {
     fn dofs(&self) -> usize;
     /// Index of the effector's x among q.
     fn effector_x(&self) -> usize;
+    /// Index of the effector's z among q.
+    fn effector_z(&self) -> usize;
     /// Rows of R in which a commanded tension may appear (the closed loop couples them to the
-    /// effector's x through the controller).
+    /// effector's coordinates the controller measures).
     fn tension_rows(&self) -> Vec<usize>;
     /// The (row, col) entries of ∂R/∂q'', ∂R/∂q' and ∂R/∂q that may be non-zero, for every state
     /// the model can reach (so one symbolic factorisation serves the run).

@@ -275,6 +275,10 @@ impl SecondOrderForm for Fe {
         self.effector_index()
     }
 
+    fn effector_z(&self) -> usize {
+        self.effector_index() + self.chain_nodes()
+    }
+
     /// T_i pulls the reel end (row ρ_i), or the rigid stored cable through l_i.
     fn tension_rows(&self) -> Vec<usize> {
         (0..2)

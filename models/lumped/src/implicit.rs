@@ -175,6 +175,10 @@ impl SecondOrderForm for Lumped {
         self.xi(0, self.elements)
     }
 
+    fn effector_z(&self) -> usize {
+        self.zi(0, self.elements)
+    }
+
     /// The commanded tension pulls the reel end P_0 along e_out (horizontal).
     fn tension_rows(&self) -> Vec<usize> {
         vec![self.xi(0, 0), self.xi(1, 0)]

@@ -5,6 +5,9 @@
 //! range; nothing here panics on bad input.
 
 use serde::Deserialize;
+
+mod controller;
+pub use controller::{Controller, ControllerKind};
 use std::fmt;
 use std::path::Path;
 
@@ -109,40 +112,6 @@ impl Cable {
 #[serde(transparent)]
 pub struct ModelSection(pub toml::Table);
 
-/// PID gains and tension distribution (MODELS.md §2).
-#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct Controller {
-    /// Proportional gain P [N/m].
-    pub p: f64,
-    /// Integral gain I [N/(m s)].
-    pub i: f64,
-    /// Derivative gain D [N s/m].
-    pub d: f64,
-    /// Derivative filter coefficient N_f [1/s].
-    pub filter: f64,
-    /// Pretension sum ΣT = T1 + T2 [N].
-    pub tension_sum: f64,
-    /// Optional lower saturation of the commanded tensions [N] (absent = off).
-    pub t_min: Option<f64>,
-    /// Optional upper saturation of the commanded tensions [N] (absent = off).
-    pub t_max: Option<f64>,
-}
-
-impl Default for Controller {
-    fn default() -> Self {
-        Self {
-            p: 1860.0,
-            i: 8700.0,
-            d: 100.0,
-            filter: 540.0,
-            tension_sum: 200.0,
-            t_min: None,
-            t_max: None,
-        }
-    }
-}
-
 /// Trajectory family; the paper uses only `step5` (eq. 13).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -164,6 +133,21 @@ pub struct Trajectory {
     pub t1: f64,
     /// End time t2 [s].
     pub t2: f64,
+    /// The vertical reference (absent: [`ZRef::Hold`] for controllers that act on z, else
+    /// [`ZRef::Free`]; see [`Scenario::z_ref`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub z_ref: Option<ZRef>,
+}
+
+/// The reference of the effector's height.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ZRef {
+    /// Not controlled: z is left to the statics (the paper). Errors in z are measured against
+    /// the start height z0.
+    Free,
+    /// The start height z0 held: a straight horizontal print line.
+    Hold,
 }
 
 impl Default for Trajectory {
@@ -174,6 +158,7 @@ impl Default for Trajectory {
             x2: 0.6,
             t1: 0.0,
             t2: 0.2,
+            z_ref: None,
         }
     }
 }
@@ -322,43 +307,7 @@ impl Scenario {
         positive("cable.modelled_length", c.modelled_length)?;
         non_negative("cable.axial_damping", c.axial_damping)?;
 
-        let k = &self.controller;
-        non_negative("controller.p", k.p)?;
-        non_negative("controller.i", k.i)?;
-        non_negative("controller.d", k.d)?;
-        positive("controller.filter", k.filter)?;
-        positive("controller.tension_sum", k.tension_sum)?;
-        if let Some(t_min) = k.t_min {
-            finite("controller.t_min", t_min)?;
-            if t_min < 0.0 || t_min >= k.tension_sum {
-                return Err(out_of_range(
-                    "controller.t_min",
-                    t_min,
-                    format!("[0, tension_sum = {}) N", k.tension_sum),
-                ));
-            }
-        }
-        if let Some(t_max) = k.t_max {
-            finite("controller.t_max", t_max)?;
-            let lower = k.t_min.unwrap_or(0.0).max(0.0);
-            if t_max <= lower {
-                return Err(out_of_range(
-                    "controller.t_max",
-                    t_max,
-                    format!("> t_min = {lower} N (finite)"),
-                ));
-            }
-        }
-        if r.gravity > 0.0 && r.effector_mass * r.gravity >= k.tension_sum {
-            return Err(out_of_range(
-                "controller.tension_sum",
-                k.tension_sum,
-                format!(
-                    "> effector weight M g = {} N (the cables cannot hold the effector otherwise)",
-                    r.effector_mass * r.gravity
-                ),
-            ));
-        }
+        self.controller.validate(r)?;
 
         let t = &self.trajectory;
         let d = r.anchor_distance;
@@ -383,6 +332,31 @@ impl Scenario {
                 t.t2,
                 format!("> t1 = {} s", t.t1),
             ));
+        }
+
+        let kind = self.controller.kind;
+        match (kind.acts_on_z(), t.z_ref) {
+            (false, Some(ZRef::Hold)) => {
+                return Err(out_of_range(
+                    "trajectory.z_ref",
+                    "\"hold\"",
+                    format!(
+                        "\"free\" with controller.kind = \"{}\": it does not act on z",
+                        kind.name()
+                    ),
+                ));
+            }
+            (true, Some(ZRef::Free)) => {
+                return Err(out_of_range(
+                    "trajectory.z_ref",
+                    "\"free\"",
+                    format!(
+                        "\"hold\" with controller.kind = \"{}\": it regulates z",
+                        kind.name()
+                    ),
+                ));
+            }
+            _ => {}
         }
 
         let s = &self.simulation;
@@ -451,6 +425,17 @@ impl Scenario {
     pub fn largest_implicit_step(&self) -> f64 {
         let t = &self.trajectory;
         ((t.t2 - t.t1) / STEPS_PER_MOVE).min(1.0 / self.controller.filter)
+    }
+
+    /// The vertical reference in force: the trajectory's `z_ref`, or the controller's default.
+    pub fn z_ref(&self) -> ZRef {
+        self.trajectory
+            .z_ref
+            .unwrap_or(if self.controller.kind.acts_on_z() {
+                ZRef::Hold
+            } else {
+                ZRef::Free
+            })
     }
 
     /// The free cable length the trajectory needs, for the massive-cable models' rule on

@@ -1,11 +1,14 @@
 //! The paper's controller (§3.2, MODELS.md §2): a parallel PID with a first-order derivative filter
 //! computing the horizontal force F on the effector, and the closed-form tension distribution of two
-//! opposed cables (Pott's method) turning F into the commanded tensions T1, T2.
+//! opposed cables (Pott's method, [`split_tensions`]) turning F into the commanded tensions T1, T2
+//! with ΣT fixed. It measures x only; z is left to the statics.
 //!
 //! The controller is part of the ODE: its integral state w and filter state f are integrated with the
 //! model, so its transfer function C(s) = P + I/s + D N_f s/(s + N_f) holds exactly.
 
-use crate::scenario;
+use super::{Controller, Measures, Output, Reference, Rest, StepStart, split_tensions};
+use crate::model::Effector;
+use crate::scenario::{self, ControllerKind};
 
 /// PID with derivative filter, Simulink parallel form: C(s) = P + I/s + D·N_f·s/(s + N_f).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -80,51 +83,89 @@ impl Pid {
     }
 }
 
-/// The closed-form split of two opposed cables' tensions (paper §3.2, MODELS.md §2): the
-/// tensions [T1, T2] = [(ΣT − F)/2, (ΣT + F)/2] [N] that sum to `tension_sum` ΣT and pull the
-/// effector toward A2 with the horizontal force `force` F [N]. The controller's distribution and
-/// every model's static equilibrium (with F = F0) use it.
-///
-/// # Examples
-///
-/// ```
-/// use cdpr_core::controller::split_tensions;
-///
-/// let [t1, t2] = split_tensions(200.0, 10.0);
-/// assert_eq!((t1, t2), (95.0, 105.0));
-/// assert_eq!(t1 + t2, 200.0);
-/// ```
-#[inline]
-pub fn split_tensions(tension_sum: f64, force: f64) -> [f64; 2] {
-    [0.5 * (tension_sum - force), 0.5 * (tension_sum + force)]
-}
-
-/// Closed-form tension distribution of two opposed cables (paper §3.2, Pott et al. 2009):
-/// T1 = (ΣT − F)/2, T2 = (ΣT + F)/2, F > 0 pulling toward A2; optional saturation to [t_min, t_max].
+/// The paper's controller: [`Pid`] on e = x_ref − x and the split of ΣT (eq. of §3.2).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TensionDistribution {
+pub struct PaperPid {
+    pub pid: Pid,
     /// Pretension sum ΣT [N].
     pub tension_sum: f64,
-    /// Lower saturation [N] (−∞ = off).
-    pub t_min: f64,
-    /// Upper saturation [N] (+∞ = off).
-    pub t_max: f64,
 }
 
-impl From<&scenario::Controller> for TensionDistribution {
+impl From<&scenario::Controller> for PaperPid {
     fn from(c: &scenario::Controller) -> Self {
         Self {
+            pid: Pid::from(c),
             tension_sum: c.tension_sum,
-            t_min: c.t_min.unwrap_or(f64::NEG_INFINITY),
-            t_max: c.t_max.unwrap_or(f64::INFINITY),
         }
     }
 }
 
-impl TensionDistribution {
-    /// Commanded tensions [T1, T2] [N] for the horizontal force F [N].
+fn pid_state(states: &[f64]) -> PidState {
+    PidState {
+        integral: states[0],
+        filter: states[1],
+    }
+}
+
+impl Controller for PaperPid {
+    fn kind(&self) -> ControllerKind {
+        ControllerKind::Pid
+    }
+    fn state_len(&self) -> usize {
+        2
+    }
+    fn measures(&self) -> Measures {
+        Measures {
+            z: false,
+            velocity: false,
+        }
+    }
     #[inline]
-    pub fn tensions(&self, force: f64) -> [f64; 2] {
-        split_tensions(self.tension_sum, force).map(|t| t.clamp(self.t_min, self.t_max))
+    fn output(&self, reference: &Reference, effector: &Effector, states: &[f64]) -> Output {
+        let error = reference.position.x - effector.position.x;
+        let force = self.pid.force(error, pid_state(states));
+        Output {
+            force,
+            tensions: split_tensions(self.tension_sum, force),
+        }
+    }
+    /// The paper's PID has no anti-windup: `saturated` is ignored.
+    fn state_rate(
+        &self,
+        reference: &Reference,
+        effector: &Effector,
+        states: &[f64],
+        _saturated: bool,
+        rate: &mut [f64],
+    ) {
+        let error = reference.position.x - effector.position.x;
+        let r = self.pid.state_rate(error, pid_state(states));
+        rate[0] = r.integral;
+        rate[1] = r.filter;
+    }
+    fn trapezoidal_step(
+        &self,
+        h: f64,
+        start: &StepStart,
+        reference: &Reference,
+        effector: &Effector,
+        out: &mut [f64],
+    ) {
+        let e_start = start.reference.position.x - start.effector.position.x;
+        let e_end = reference.position.x - effector.position.x;
+        let s = self
+            .pid
+            .trapezoidal_step(pid_state(start.states), e_start, e_end, h);
+        out[0] = s.integral;
+        out[1] = s.filter;
+    }
+    fn rest_states(&self, _: &Reference, _: &Effector, rest: &Rest, out: &mut [f64]) {
+        let s = self.pid.state_holding(rest.force).unwrap_or_default();
+        out[0] = s.integral;
+        out[1] = s.filter;
+    }
+    /// F is affine in x: a unit step gives dT/dx exactly.
+    fn difference_step(&self) -> f64 {
+        1.0
     }
 }

@@ -1,0 +1,127 @@
+//! The vibration-control metrics of a run: how closely the effector holds the printing path
+//! during the move, how soon x and z settle, what the tensions did and how long they were
+//! clamped. Errors in z are measured from the start height z0 (the held reference where z is
+//! held, the start where z is free), so every controller is judged against the same straight
+//! line.
+
+use cdpr_core::channel::Channel;
+use cdpr_core::controller::TensionLimits;
+use cdpr_core::runner::Run;
+use std::collections::BTreeMap;
+
+/// The transition window ends this long after the move (or the shaped reference) ends [s].
+pub const TRANSITION_TAIL: f64 = 0.05;
+/// The settling band of x and z [m] (10 µm: a tenth of the thinnest printed layer).
+pub const SETTLE_BAND: f64 = 1e-5;
+/// The window of the settled mean of z at the record's end [s].
+pub const Z_MEAN_WINDOW: f64 = 0.5;
+
+/// What the control metrics need to know of the run besides its samples.
+#[derive(Debug, Clone, Copy)]
+pub struct ControlContext<'a> {
+    /// The controller's scenario name.
+    pub controller: &'a str,
+    /// The move's start and end [s] (the end of the shaped reference where one is shaped).
+    pub move_start: f64,
+    pub move_end: f64,
+    pub limits: TensionLimits,
+    /// Sample period [s].
+    pub sample_period: f64,
+}
+
+/// Keys of `metrics.json` (SI units, in [`crate::metrics::UNITS`]; NaN is null).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ControlMetrics {
+    pub controller: String,
+    /// max √(e_x² + e_z²) over [move start, move end + 0.05 s] [m].
+    pub path_err_max_transition: f64,
+    /// max |e_x|, max |e_z| over the same window [m].
+    pub ex_max_transition: f64,
+    pub ez_max_transition: f64,
+    /// The time after which |e_x| stays below 10 µm [s] (null if it never does).
+    pub x_settle_s: f64,
+    /// The time after which |z − mean z over the last 0.5 s| stays below 10 µm [s].
+    pub z_settle_s: f64,
+    /// Extremes of both commanded tensions over the record [N].
+    pub tension_min: f64,
+    pub tension_max: f64,
+    /// Time with a commanded tension at a limit [s] (sample count × sample period).
+    pub saturated_s: f64,
+    /// Largest growth rate of the closed loop's modes at the end of the move [1/s] (from the
+    /// modal analysis; null where it was not done).
+    pub least_stable_growth: f64,
+    /// The controller's designed gains (the LQR's K, row-major 2 × 6, …).
+    pub controller_gains: BTreeMap<String, Vec<f64>>,
+}
+
+impl ControlMetrics {
+    /// Computes the metrics of `run`'s samples.
+    pub fn from_run(run: &Run, context: &ControlContext) -> Self {
+        let s = &run.series;
+        let col = |channel: Channel| s.column(channel).unwrap_or_default();
+        let (t, z, err, t1, t2) = (
+            col(Channel::Time),
+            col(Channel::Z),
+            col(Channel::Error),
+            col(Channel::T1),
+            col(Channel::T2),
+        );
+        let z0 = z.first().copied().unwrap_or(f64::NAN);
+        let half = 0.5 * context.sample_period;
+        let transition = t.partition_point(|&v| v < context.move_start - half)
+            ..t.partition_point(|&v| v <= context.move_end + TRANSITION_TAIL + half);
+        let (mut path, mut ex, mut ez) = (f64::NAN, f64::NAN, f64::NAN);
+        for i in transition {
+            let (e_x, e_z) = (err[i], z[i] - z0);
+            path = e_x.hypot(e_z).max(if path.is_nan() { 0.0 } else { path });
+            ex = e_x.abs().max(if ex.is_nan() { 0.0 } else { ex });
+            ez = e_z.abs().max(if ez.is_nan() { 0.0 } else { ez });
+        }
+        let t_end = t.last().copied().unwrap_or(0.0);
+        let last = t.partition_point(|&v| v < t_end - Z_MEAN_WINDOW - half);
+        let z_end = mean(&z[last..]);
+        let tensions = t1.iter().chain(&t2);
+        let at_limit = |v: f64| v <= context.limits.t_min || v >= context.limits.t_max;
+        let saturated = t1
+            .iter()
+            .zip(&t2)
+            .filter(|&(&a, &b)| at_limit(a) || at_limit(b))
+            .count();
+        Self {
+            controller: context.controller.to_owned(),
+            path_err_max_transition: path,
+            ex_max_transition: ex,
+            ez_max_transition: ez,
+            x_settle_s: settle_time(&t, err.iter().map(|e| e.abs())),
+            z_settle_s: settle_time(&t, z.iter().map(|v| (v - z_end).abs())),
+            tension_min: tensions.clone().fold(f64::NAN, |m, &v| v.min(m)),
+            tension_max: tensions.fold(f64::NAN, |m, &v| v.max(m)),
+            saturated_s: saturated as f64 * context.sample_period,
+            least_stable_growth: f64::NAN,
+            controller_gains: BTreeMap::new(),
+        }
+    }
+}
+
+/// The first sample time after the last sample whose deviation is ≥ [`SETTLE_BAND`]; the
+/// record's start if none is; NaN if the last sample is outside the band.
+fn settle_time(t: &[f64], deviation: impl Iterator<Item = f64>) -> f64 {
+    let mut last_out = None;
+    for (i, d) in deviation.enumerate() {
+        if d >= SETTLE_BAND || d.is_nan() {
+            last_out = Some(i);
+        }
+    }
+    match last_out {
+        None => t.first().copied().unwrap_or(f64::NAN),
+        Some(i) if i + 1 < t.len() => t[i + 1],
+        Some(_) => f64::NAN,
+    }
+}
+
+fn mean(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.iter().sum::<f64>() / v.len() as f64
+}

@@ -1,0 +1,255 @@
+//! The implicit path (MODELS.md FE.9.3): the model's second-order form with the controller's
+//! states updated by its A-stable trapezoidal step inside the same residual, so the tensions at
+//! t_{n+1} follow the effector state of the iterate, and the audit states W, D by the
+//! trapezoidal rule after convergence. Only for models that offer
+//! [`CableModel::second_order`] (the runner checks first).
+
+use super::{ClosedLoop, Command, MAX_CONTROLLER_STATES};
+use crate::controller::{self, Reference};
+use crate::model::{CableModel, Effector};
+use cdpr_numerics::{MatrixCost, SecondOrderSystem};
+
+/// What an implicit step needs from its start (t_n, y_n) besides the integrator's own state.
+#[derive(Debug, Clone)]
+pub(super) struct StepStart {
+    h: f64,
+    reference: Reference,
+    effector: Option<Effector>,
+    states: [f64; MAX_CONTROLLER_STATES],
+    saturated: bool,
+    /// Reel power Σ T_i v_reel,i [W] and model dissipation [W] at t_n.
+    power: f64,
+    dissipation: f64,
+    /// W and D at t_n [J].
+    work: f64,
+    dissipated: f64,
+}
+
+impl StepStart {
+    pub(super) fn new(_controller_states: usize) -> Self {
+        Self {
+            h: 0.0,
+            reference: Reference::default(),
+            effector: None,
+            states: [0.0; MAX_CONTROLLER_STATES],
+            saturated: false,
+            power: 0.0,
+            dissipation: 0.0,
+            work: 0.0,
+            dissipated: 0.0,
+        }
+    }
+}
+
+impl<M: CableModel> ClosedLoop<M> {
+    /// The command at the end t of the current implicit step for the effector state `effector`,
+    /// and the controller states advanced there from the step's start (into `states`).
+    fn step_end_command(
+        &self,
+        t: f64,
+        effector: &Effector,
+        states: &mut [f64; MAX_CONTROLLER_STATES],
+    ) -> Command {
+        let s = &self.step_start;
+        let c = self.controller_len();
+        let reference = self.reference(t);
+        let start = controller::StepStart {
+            reference: s.reference,
+            effector: s.effector.unwrap_or(*effector),
+            states: &s.states[..c],
+            saturated: s.saturated,
+        };
+        self.controller
+            .trapezoidal_step(s.h, &start, &reference, effector, &mut states[..c]);
+        self.command_with(t, &reference, effector, &states[..c])
+    }
+
+    /// The effector columns (x, then z where the controller measures it) of the iteration
+    /// matrix that close the loop through the tension rows.
+    fn effector_columns(&self) -> Vec<usize> {
+        let Some(form) = self.model.second_order() else {
+            return Vec::new();
+        };
+        let mut columns = vec![form.effector_x()];
+        if self.controller.measures().z {
+            columns.push(form.effector_z());
+        }
+        columns
+    }
+
+    /// dT/dq_k + (c_v/c_q) dT/dq'_k of the step-end tensions for the effector coordinate k
+    /// (0: x, 1: z), by one-sided differences of the controller's advised step (exact for an
+    /// affine controller with a unit step).
+    fn tension_slope(
+        &self,
+        t: f64,
+        effector: &Effector,
+        tensions: [f64; 2],
+        k: usize,
+        c_v: f64,
+        c_q: f64,
+    ) -> [f64; 2] {
+        let delta = self.controller.difference_step();
+        let mut buffer = [0.0; MAX_CONTROLLER_STATES];
+        let mut moved = *effector;
+        moved.position[k] += delta;
+        let at = self.step_end_command(t, &moved, &mut buffer).tensions;
+        let mut slope = [(at[0] - tensions[0]) / delta, (at[1] - tensions[1]) / delta];
+        if self.controller.measures().velocity {
+            let mut moving = *effector;
+            moving.velocity[k] += delta;
+            let at = self.step_end_command(t, &moving, &mut buffer).tensions;
+            for i in 0..2 {
+                slope[i] += c_v / c_q * (at[i] - tensions[i]) / delta;
+            }
+        }
+        slope
+    }
+}
+
+impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
+    fn dofs(&self) -> usize {
+        self.model.second_order().map_or(0, |f| f.dofs())
+    }
+
+    fn iteration_pattern(&self) -> Vec<(usize, usize)> {
+        let Some(form) = self.model.second_order() else {
+            return Vec::new();
+        };
+        let mut pattern = form.iteration_pattern();
+        let rows = form.tension_rows();
+        for column in self.effector_columns() {
+            pattern.extend(rows.iter().map(|&row| (row, column)));
+        }
+        pattern
+    }
+
+    /// The model's own, and the effector's measured coordinates: the controller feeds them back
+    /// into the tension rows at the reel ends, which closes the cables' chains (reel, …,
+    /// effector, …, reel) into a loop.
+    fn coupled_unknowns(&self) -> Vec<usize> {
+        let Some(form) = self.model.second_order() else {
+            return Vec::new();
+        };
+        let mut coupled = form.coupled_unknowns();
+        if !form.tension_rows().is_empty() {
+            coupled.extend(self.effector_columns());
+        }
+        coupled
+    }
+
+    fn begin_step(&mut self, t: f64, y: &[f64], h: f64) {
+        let n = self.model_len();
+        let c = self.controller_len();
+        let cmd = self.command(t, y);
+        let model_state = &y[..n];
+        let reel = self.model.reel_speeds(model_state);
+        let effector = self.model.effector(model_state);
+        let reference = self.reference(t);
+        let dissipation = self.model.dissipation(model_state);
+        let s = &mut self.step_start;
+        s.h = h;
+        s.reference = reference;
+        s.effector = Some(effector);
+        s.states[..c].copy_from_slice(&y[n..n + c]);
+        s.saturated = cmd.saturated;
+        s.power = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
+        s.dissipation = dissipation;
+        s.work = y[n + c];
+        s.dissipated = y[n + c + 1];
+    }
+
+    fn residual(&mut self, t: f64, y: &[f64], qdd: &[f64], r: &mut [f64]) {
+        let n = self.model_len();
+        let effector = self.model.effector(&y[..n]);
+        let mut states = [0.0; MAX_CONTROLLER_STATES];
+        let tensions = self.step_end_command(t, &effector, &mut states).tensions;
+        if let Some(form) = self.model.second_order_mut() {
+            form.residual(&y[..n], qdd, tensions, r);
+        }
+    }
+
+    fn iteration_matrix(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        qdd: &[f64],
+        c_v: f64,
+        c_q: f64,
+        values: &mut [f64],
+    ) -> MatrixCost {
+        let n = self.model_len();
+        let effector = self.model.effector(&y[..n]);
+        let mut states = [0.0; MAX_CONTROLLER_STATES];
+        let tensions = self.step_end_command(t, &effector, &mut states).tensions;
+        let columns = self.effector_columns().len();
+        let mut slopes = [[0.0; 2]; 2];
+        for (k, slope) in slopes.iter_mut().enumerate().take(columns) {
+            *slope = self.tension_slope(t, &effector, tensions, k, c_v, c_q);
+        }
+        let [base, probe] = &mut self.residual_scratch;
+        let Some(form) = self.model.second_order_mut() else {
+            return MatrixCost::default();
+        };
+        // The pattern is the model's, then one entry (row, column) per tension row and column.
+        let rows = form.tension_rows();
+        let (model_values, tension_values) =
+            values.split_at_mut(values.len() - rows.len() * columns);
+        let mut cost = form.iteration_matrix(&y[..n], qdd, tensions, c_v, c_q, model_values);
+        base.resize(form.dofs(), 0.0);
+        probe.resize(form.dofs(), 0.0);
+        let mut base_done = false;
+        for (slope, column_values) in slopes[..columns]
+            .iter()
+            .zip(tension_values.chunks_mut(rows.len().max(1)))
+        {
+            if *slope == [0.0, 0.0] || rows.is_empty() {
+                column_values.fill(0.0);
+                continue;
+            }
+            // The column of ∂R/∂T · dT/dq, by residuals (R is linear in T).
+            if !base_done {
+                form.residual(&y[..n], qdd, tensions, base);
+                cost = cost.plus_residuals(1);
+                base_done = true;
+            }
+            let pulled = [tensions[0] + slope[0], tensions[1] + slope[1]];
+            form.residual(&y[..n], qdd, pulled, probe);
+            cost = cost.plus_residuals(1);
+            for (value, &row) in column_values.iter_mut().zip(&rows) {
+                *value = c_q * (probe[row] - base[row]);
+            }
+        }
+        cost
+    }
+
+    fn tail_rate(&mut self, t: f64, y: &[f64], out: &mut [f64]) {
+        let n = self.model_len();
+        let effector = self.model.effector(&y[..n]);
+        let reference = self.reference(t);
+        let cmd = self.command(t, y);
+        self.controller_and_audit_rates(y, (&reference, &effector), &cmd, out);
+    }
+
+    fn residual_round_off(&self, y: &[f64]) -> f64 {
+        let n = self.model_len();
+        self.model
+            .second_order()
+            .map_or(0.0, |f| f.residual_round_off(&y[..n]))
+    }
+
+    fn end_step(&mut self, t: f64, y: &mut [f64]) {
+        let n = self.model_len();
+        let c = self.controller_len();
+        let effector = self.model.effector(&y[..n]);
+        let mut states = [0.0; MAX_CONTROLLER_STATES];
+        let cmd = self.step_end_command(t, &effector, &mut states);
+        y[n..n + c].copy_from_slice(&states[..c]);
+        let reel = self.model.reel_speeds(&y[..n]);
+        let power = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
+        let dissipation = self.model.dissipation(&y[..n]);
+        let s = &self.step_start;
+        y[n + c] = s.work + 0.5 * s.h * (s.power + power);
+        y[n + c + 1] = s.dissipated + 0.5 * s.h * (s.dissipation + dissipation);
+    }
+}

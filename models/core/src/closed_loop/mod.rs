@@ -1,0 +1,191 @@
+//! The closed loop of the paper's Fig. 4: reference → controller → tension limits → cable
+//! model, as one ODE ([`ClosedLoop`]), in first-order form for DOPRI5 and in second-order form
+//! for generalised-α ([`implicit`]). The runner that integrates it is [`crate::runner`].
+//!
+//! State layout: `[model state (n) | controller states (c) | W | D]`: the controller's own states
+//! (the paper's PID: integral w and filter f), then two audit states excluded from the error
+//! norm, the reels' work W = ∫ Σ T_i v_reel,i dt and the energy dissipated inside the model D.
+//! They make the energy balance E(t) − E(0) − W(t) + D(t) − ΣΔE = 0 (ΔE the energy changes of
+//! model events) a channel of every run.
+
+mod implicit;
+mod rest;
+
+use crate::Vector2;
+use crate::controller::{self, Controller, Reference, TensionLimits};
+use crate::model::{CableModel, Effector};
+use crate::scenario::Scenario;
+use crate::trajectory::Step5;
+use cdpr_numerics::OdeSystem;
+
+/// Where the commanded tensions come from.
+pub enum Actuation {
+    /// The scenario's controller, clamped to the tension limits.
+    Controller,
+    /// Tensions prescribed as functions of time [s] → [T1, T2] [N]; the controller states still
+    /// integrate the error but do not act (energy and verification runs).
+    Prescribed(Box<dyn Fn(f64) -> [f64; 2] + Send + Sync>),
+}
+
+/// What the controller commands at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Command {
+    /// x_ref [m].
+    pub reference: f64,
+    /// e = x_ref − x [m].
+    pub error: f64,
+    /// The controller's horizontal force F [N] (pulls toward A2 when positive).
+    pub force: f64,
+    /// Commanded tensions [T1, T2] [N], inside the limits.
+    pub tensions: [f64; 2],
+    /// Whether the limits clamped the controller's tensions.
+    pub saturated: bool,
+}
+
+/// Number of audit states (W, D) after the controller's.
+pub const AUDIT_STATES: usize = 2;
+
+/// Most controller states any controller has (stack buffers of the implicit step).
+pub const MAX_CONTROLLER_STATES: usize = 8;
+
+/// Model + controller as one [`OdeSystem`].
+pub struct ClosedLoop<M: CableModel> {
+    pub model: M,
+    pub trajectory: Step5,
+    pub controller: Box<dyn Controller>,
+    pub limits: TensionLimits,
+    pub actuation: Actuation,
+    /// ΣT of the start equilibrium (MODELS.md §2) [N].
+    pub tension_sum: f64,
+    /// The held height z0 [m] once the start equilibrium is known (the reference's z).
+    z_hold: Option<f64>,
+    /// The tensions of the last rest state ([`ClosedLoop::rest_state`]) [N].
+    rest_tensions: [f64; 2],
+    /// The start of the current implicit step.
+    step_start: implicit::StepStart,
+    /// Two residuals for the tension columns of the implicit iteration matrix (allocated once).
+    residual_scratch: [Vec<f64>; 2],
+}
+
+impl<M: CableModel> ClosedLoop<M> {
+    /// The loop for `model` with the scenario's controller, limits and trajectory.
+    pub fn new(model: M, scenario: &Scenario) -> Self {
+        let controller = controller::build(scenario);
+        let c = controller.state_len();
+        debug_assert!(c <= MAX_CONTROLLER_STATES, "controller with {c} states");
+        Self {
+            model,
+            trajectory: Step5::from(&scenario.trajectory),
+            controller,
+            limits: TensionLimits::from(&scenario.controller),
+            actuation: Actuation::Controller,
+            tension_sum: scenario.controller.tension_sum,
+            z_hold: None,
+            rest_tensions: [0.0; 2],
+            step_start: implicit::StepStart::new(c),
+            residual_scratch: Default::default(),
+        }
+    }
+
+    /// Length of the model's part of the state.
+    pub fn model_len(&self) -> usize {
+        self.model.state_len()
+    }
+
+    /// Number of the controller's states (after the model's).
+    pub fn controller_len(&self) -> usize {
+        self.controller.state_len()
+    }
+
+    /// Model and controller states: the part of the state the error norm and the
+    /// linearisation see (the audits excluded).
+    pub fn dynamic_len(&self) -> usize {
+        self.model_len() + self.controller_len()
+    }
+
+    /// The reference at time t [s]: x, ẋ, ẍ from `step5`; z the held start height z0 (0 before
+    /// the start equilibrium is known), at rest.
+    #[inline]
+    pub fn reference(&self, t: f64) -> Reference {
+        let z = self.z_hold.unwrap_or(0.0);
+        Reference {
+            position: Vector2::new(self.trajectory.position(t), z),
+            velocity: Vector2::new(self.trajectory.velocity(t), 0.0),
+            acceleration: Vector2::new(self.trajectory.acceleration(t), 0.0),
+        }
+    }
+
+    /// The held start height z0 [m], once [`ClosedLoop::initial_state`] has found it.
+    pub fn hold_height(&self) -> Option<f64> {
+        self.z_hold
+    }
+
+    /// Reference, error, force and commanded tensions at (t, y).
+    #[inline]
+    pub fn command(&self, t: f64, y: &[f64]) -> Command {
+        let n = self.model_len();
+        let effector = self.model.effector(&y[..n]);
+        let states = &y[n..n + self.controller_len()];
+        self.command_with(t, &self.reference(t), &effector, states)
+    }
+
+    /// The command for a given reference, effector and controller states.
+    #[inline]
+    fn command_with(
+        &self,
+        t: f64,
+        reference: &Reference,
+        effector: &Effector,
+        states: &[f64],
+    ) -> Command {
+        let out = self.controller.output(reference, effector, states);
+        let (tensions, saturated) = match &self.actuation {
+            Actuation::Controller => self.limits.clamp(out.tensions),
+            Actuation::Prescribed(f) => (f(t), false),
+        };
+        Command {
+            reference: reference.position.x,
+            error: reference.position.x - effector.position.x,
+            force: out.force,
+            tensions,
+            saturated,
+        }
+    }
+
+    /// Rates of the states after the model's (controller, W', D') at state `y` under `cmd`,
+    /// with the reference and the effector of (t, y).
+    fn controller_and_audit_rates(
+        &self,
+        y: &[f64],
+        (reference, effector): (&Reference, &Effector),
+        cmd: &Command,
+        out: &mut [f64],
+    ) {
+        let n = self.model_len();
+        let c = self.controller_len();
+        let model_state = &y[..n];
+        let (rates, audits) = out.split_at_mut(c);
+        self.controller
+            .state_rate(reference, effector, &y[n..n + c], cmd.saturated, rates);
+        let reel = self.model.reel_speeds(model_state);
+        audits[0] = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
+        audits[1] = self.model.dissipation(model_state);
+    }
+}
+
+impl<M: CableModel> OdeSystem for ClosedLoop<M> {
+    fn dimension(&self) -> usize {
+        self.dynamic_len() + AUDIT_STATES
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        let n = self.model_len();
+        let effector = self.model.effector(&y[..n]);
+        let reference = self.reference(t);
+        let states = &y[n..n + self.controller_len()];
+        let cmd = self.command_with(t, &reference, &effector, states);
+        let (model_rate, tail) = dy.split_at_mut(n);
+        self.model.rhs(t, &y[..n], cmd.tensions, model_rate);
+        self.controller_and_audit_rates(y, (&reference, &effector), &cmd, tail);
+    }
+}

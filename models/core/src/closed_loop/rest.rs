@@ -1,0 +1,116 @@
+//! The closed loop at rest (MODELS.md §2): the start of every run and the point a linearisation is
+//! taken about. The model's static equilibrium with the effector at x; for a controller that acts
+//! on z, at the held height z0 (the pretension found by a secant iteration on ΣT, since the
+//! models' statics fix x and ΣT); the controller's states holding the equilibrium's tensions.
+
+use super::ClosedLoop;
+use crate::Vector2;
+use crate::controller::{Reference, Rest, split_tensions};
+use crate::model::{CableModel, Equilibrium, ModelError};
+
+/// Tolerance of the held height in the secant iteration [m] (a few ulps of a 0.1 m height).
+const HEIGHT_TOLERANCE: f64 = 1e-14;
+/// Most secant iterations on ΣT (the height is smooth and monotone in ΣT: 4–6 suffice).
+const MAX_SECANT_ITERATIONS: usize = 40;
+
+impl<M: CableModel> ClosedLoop<M> {
+    /// Initial state by the rule of MODELS.md §2: the model's static equilibrium with the effector
+    /// at x_ref(0), ΣT the scenario's and F0 unknown, velocities zero, the controller's states
+    /// holding the equilibrium's tensions (the paper's PID: w(0) = F0/I, f(0) = e(0) = 0), audits
+    /// zero. The equilibrium's height becomes the held height z0 of the reference.
+    pub fn initial_state(&mut self) -> Result<(Vec<f64>, Equilibrium), ModelError> {
+        let x = self.trajectory.position(0.0);
+        let eq = self.model.equilibrium(x, self.tension_sum)?;
+        let z0 = self.model.effector(&eq.state).position.y;
+        self.set_hold_height(z0)?;
+        Ok((self.assemble(x, &eq, self.tension_sum), eq))
+    }
+
+    /// Sets the held height z0 [m] of the reference (and re-designs a controller designed there).
+    pub fn set_hold_height(&mut self, z0: f64) -> Result<(), ModelError> {
+        self.z_hold = Some(z0);
+        self.controller.hold_height(z0)?;
+        Ok(())
+    }
+
+    /// The closed loop at rest with the effector at x [m]: for the paper's PID (z free) the
+    /// model's equilibrium at ΣT; for controllers acting on z, the equilibrium at (x, z0), z0 the
+    /// held height (found from the start equilibrium first if not yet known).
+    pub fn rest_state(&mut self, x: f64) -> Result<(Vec<f64>, Equilibrium), ModelError> {
+        if !self.controller.kind().acts_on_z() {
+            let eq = self.model.equilibrium(x, self.tension_sum)?;
+            return Ok((self.assemble(x, &eq, self.tension_sum), eq));
+        }
+        if self.z_hold.is_none() {
+            self.initial_state()?;
+        }
+        let z0 = self.z_hold.unwrap_or_default();
+        let (eq, tension_sum) = self.equilibrium_at_height(x, z0)?;
+        Ok((self.assemble(x, &eq, tension_sum), eq))
+    }
+
+    /// The tensions [T1, T2] [N] of the last rest state.
+    pub fn rest_tensions(&self) -> [f64; 2] {
+        self.rest_tensions
+    }
+
+    /// The model's equilibrium with the effector at (x, z0): the secant iteration on ΣT of
+    /// z(ΣT) = z0. Returns the equilibrium and its ΣT [N].
+    fn equilibrium_at_height(&mut self, x: f64, z0: f64) -> Result<(Equilibrium, f64), ModelError> {
+        let height = |loop_: &mut Self, sum: f64| -> Result<(Equilibrium, f64), ModelError> {
+            let eq = loop_.model.equilibrium(x, sum)?;
+            let z = loop_.model.effector(&eq.state).position.y;
+            Ok((eq, z - z0))
+        };
+        let mut s0 = self.tension_sum;
+        let (mut eq, mut f0) = height(self, s0)?;
+        let mut s1 = 1.01 * s0;
+        for _ in 0..MAX_SECANT_ITERATIONS {
+            if f0.abs() <= HEIGHT_TOLERANCE {
+                return Ok((eq, s0));
+            }
+            let (eq1, f1) = height(self, s1)?;
+            if f1 == f0 {
+                break;
+            }
+            let s2 = s1 - f1 * (s1 - s0) / (f1 - f0);
+            (s0, f0, eq) = (s1, f1, eq1);
+            s1 = s2;
+            if (s1 - s0).abs() <= 1e-15 * s0.abs() {
+                return Ok((eq, s0));
+            }
+        }
+        if f0.abs() <= 1e-9 {
+            return Ok((eq, s0));
+        }
+        Err(ModelError::Parameter {
+            name: "held height z0",
+            value: z0,
+            allowed: format!(
+                "a height the cables can hold at x = {x} m (secant on ΣT stopped {f0:e} m away)"
+            ),
+        })
+    }
+
+    /// `[equilibrium state | controller states holding its tensions | 0 | 0]`.
+    fn assemble(&mut self, x: f64, eq: &Equilibrium, tension_sum: f64) -> Vec<f64> {
+        let effector = self.model.effector(&eq.state);
+        let tensions = split_tensions(tension_sum, eq.force);
+        self.rest_tensions = tensions;
+        let reference = Reference {
+            position: Vector2::new(x, self.z_hold.unwrap_or(effector.position.y)),
+            ..Reference::default()
+        };
+        let rest = Rest {
+            tensions,
+            force: eq.force,
+        };
+        let c = self.controller_len();
+        let mut y = eq.state.clone();
+        y.resize(eq.state.len() + c + super::AUDIT_STATES, 0.0);
+        let n = eq.state.len();
+        self.controller
+            .rest_states(&reference, &effector, &rest, &mut y[n..n + c]);
+        y
+    }
+}
