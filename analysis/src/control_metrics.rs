@@ -50,6 +50,9 @@ pub struct ControlMetrics {
     /// Largest growth rate of the closed loop's modes at the end of the move [1/s] (from the
     /// modal analysis; null where it was not done).
     pub least_stable_growth: f64,
+    /// That mode's frequency [rad/s] and kind ("axial cable 2", …; empty where not done).
+    pub least_stable_omega_rad_s: f64,
+    pub least_stable_kind: String,
     /// The controller's designed gains (the LQR's K, row-major 2 × 6, …).
     pub controller_gains: BTreeMap<String, Vec<f64>>,
 }
@@ -98,6 +101,8 @@ impl ControlMetrics {
             tension_max: tensions.fold(f64::NAN, |m, &v| v.max(m)),
             saturated_s: saturated as f64 * context.sample_period,
             least_stable_growth: f64::NAN,
+            least_stable_omega_rad_s: f64::NAN,
+            least_stable_kind: String::new(),
             controller_gains: BTreeMap::new(),
         }
     }

@@ -201,6 +201,8 @@ pub const UNITS: &[(&str, &str)] = &[
     ("tension_max", "N"),
     ("saturated_s", "s"),
     ("least_stable_growth", "1/s"),
+    ("least_stable_omega_rad_s", "rad/s"),
+    ("least_stable_kind", ""),
     ("controller_gains", "SI"),
 ];
 

@@ -190,14 +190,26 @@ fn hamiltonian_start(a: &Mat<f64>, s: &Mat<f64>, q: &Mat<f64>) -> Result<Mat<f64
         (false, true) => -q[(i - n, j)],
         (false, false) => -a[(j - n, i - n)],
     });
-    let evd = h.eigen().map_err(|_| RiccatiError::Eigen)?;
-    let (u, lambda) = (evd.U(), evd.S());
-    let stable: Vec<usize> = (0..2 * n)
+    // Balanced first (D⁻¹ H D, D a diagonal of powers of 2): printer-scale weights put 1e10
+    // next to 1 in H, and the unbalanced eigen-solver's error ε‖H‖ then blurs the two halves
+    // of the spectrum. The eigenvectors of H are D times those of the balanced matrix.
+    let (balanced, d) = crate::eigen::balance(&h);
+    let evd = balanced.eigen().map_err(|_| RiccatiError::Eigen)?;
+    let (ub, lambda) = (evd.U(), evd.S());
+    let u = Mat::<c64>::from_fn(2 * n, 2 * n, |i, k| ub[(i, k)] * d[i]);
+    // H's spectrum is symmetric about the imaginary axis: its stable half is the n eigenvalues
+    // of smallest real part. Counting Re λ < 0 instead fails on badly scaled weights (Q ~ 1e10
+    // against R ~ 1), where round-off moves an eigenvalue of either half across zero; the start
+    // only has to be good enough for Newton–Kleinman, whose result is checked to stabilise.
+    let mut order: Vec<usize> = (0..2 * n).collect();
+    order.sort_by(|&a, &b| lambda[a].re.total_cmp(&lambda[b].re));
+    let stable: Vec<usize> = order[..n].to_vec();
+    let strictly = (0..2 * n)
         .filter(|&k| lambda[k].re < -1e-12 * (1.0 + lambda[k].norm()))
-        .collect();
-    if stable.len() != n {
+        .count();
+    if n > 0 && lambda[order[n - 1]].re >= 1e-9 * (1.0 + lambda[order[n - 1]].norm()) {
         return Err(RiccatiError::NoStableSubspace {
-            stable: stable.len(),
+            stable: strictly,
             n,
         });
     }

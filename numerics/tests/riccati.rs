@@ -125,3 +125,47 @@ fn unstabilisable_and_malformed_problems_are_errors() {
     let err = care(&a, &b, &Mat::<f64>::identity(3, 3), &r).unwrap_err();
     assert!(matches!(err, RiccatiError::Dimensions(_)), "{err:?}");
 }
+
+/// K is invariant under scaling Q and R together (the cost scales, the minimiser does not), so
+/// the printer-scale weights (position error of 10 µm against 1 N: Q ~ 1e10, R = 1) must give
+/// the gain of the same problem scaled to Q ~ 1. Two decoupled axes of ẍ = u with integral
+/// action, the shape of the LQR controller's design; counting Re λ < 0 in the Hamiltonian
+/// failed here before (7 or 5 eigenvalues instead of 6).
+#[test]
+fn badly_scaled_weights_give_the_scaled_problem_s_gain() {
+    let n = 6;
+    let a = Mat::from_fn(n, n, |i, j| {
+        // ξ = (x, z, ẋ, ż, ∫x, ∫z)
+        if (i < 2 && j == i + 2) || (i >= 4 && j == i - 4) {
+            1.0
+        } else {
+            0.0
+        }
+    });
+    let b = Mat::from_fn(n, 2, |i, j| if i == j + 2 { 1.0 } else { 0.0 });
+    for (qp, qv, qi) in [(1e10, 1e6, 1e10), (1e9, 1e5, 1e11), (3e8, 1e4, 3e9)] {
+        let q = |scale: f64| {
+            Mat::from_fn(n, n, |i, j| {
+                if i != j {
+                    0.0
+                } else {
+                    scale * [qp, qp, qv, qv, qi, qi][i]
+                }
+            })
+        };
+        let r = |scale: f64| Mat::from_fn(2, 2, |i, j| if i == j { scale } else { 0.0 });
+        let big = care(&a, &b, &q(1.0), &r(1.0)).unwrap_or_else(|e| panic!("{qp:e}: {e}"));
+        let small = care(&a, &b, &q(1.0 / qp), &r(1.0 / qp))
+            .unwrap_or_else(|e| panic!("scaled {qp:e}: {e}"));
+        for i in 0..2 {
+            for j in 0..n {
+                let (k1, k2) = (big.gain[(i, j)], small.gain[(i, j)]);
+                // Both solves end at round-off of their X; the gains agree to 1e-8 relative.
+                assert!(
+                    (k1 - k2).abs() <= 1e-8 * k2.abs().max(1.0),
+                    "{qp:e}: K[{i},{j}] {k1} vs {k2}"
+                );
+            }
+        }
+    }
+}

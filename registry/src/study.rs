@@ -10,7 +10,7 @@ use cdpr_analysis::control_metrics::ControlContext;
 use cdpr_analysis::damping::{self, Sweep};
 use cdpr_analysis::linearise::{self, EndState, Linearised};
 use cdpr_analysis::metrics::Metrics;
-use cdpr_analysis::modes::{Analysis, Loop};
+use cdpr_analysis::modes::{Analysis, ClassifiedMode, Loop};
 use cdpr_core::closed_loop::ClosedLoop;
 use cdpr_core::controller::TensionLimits;
 use cdpr_core::model::{CableModel, ModelError};
@@ -123,9 +123,13 @@ pub fn assess(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Asse
 pub fn assess_observed(scenario: &Scenario, observer: &mut Observer) -> Result<Assessed, Error> {
     let kind = ModelConfig::from_scenario(scenario)?.kind;
     let run = simulate_observed(scenario, observer)?;
-    let (end, least_stable_growth) = end_analysis_and_growth(scenario);
+    let (end, least_stable) = end_analysis_and_growth(scenario);
     let mut metrics = metrics(scenario, &run);
-    metrics.control.least_stable_growth = least_stable_growth;
+    if let Some(mode) = least_stable {
+        metrics.control.least_stable_growth = mode.mode.growth;
+        metrics.control.least_stable_omega_rad_s = mode.mode.omega;
+        metrics.control.least_stable_kind = mode.kind.to_string();
+    }
     Ok(Assessed {
         kind,
         metrics,
@@ -156,30 +160,33 @@ pub fn end_analysis(scenario: &Scenario) -> EndAnalysis {
     end_analysis_and_growth(scenario).0
 }
 
-/// [`end_analysis`] and the largest growth rate of the closed loop's modes at x2 [1/s], from
-/// the modal analysis that drops the frozen coordinates ([`analyse`]; NaN where it was not
+/// [`end_analysis`] and the closed loop's least stable mode at x2 (largest growth rate), from
+/// the modal analysis that drops the frozen coordinates ([`analyse`]; None where it was not
 /// done or failed). A loop without an oscillatory mode near eq. 15 (a z loop that over-damps
-/// it) fails the end state but still has its growth rate.
-pub fn end_analysis_and_growth(scenario: &Scenario) -> (EndAnalysis, f64) {
+/// it) fails the end state but still has its least stable mode.
+pub fn end_analysis_and_growth(scenario: &Scenario) -> (EndAnalysis, Option<ClassifiedMode>) {
     if scenario.analysis.modes == ModesChoice::Off {
         let reason = "[analysis] modes = \"off\"".into();
-        return (EndAnalysis::Skipped { reason }, f64::NAN);
+        return (EndAnalysis::Skipped { reason }, None);
     }
     let end = match end_state(scenario) {
         Ok(end) => EndAnalysis::Done(end),
         Err(Error::Analysis(e @ AnalysisError::TooLarge { .. })) => {
             let reason = e.to_string();
-            return (EndAnalysis::Skipped { reason }, f64::NAN);
+            return (EndAnalysis::Skipped { reason }, None);
         }
         Err(e) => EndAnalysis::Failed {
             reason: e.to_string(),
         },
     };
-    let growth = analyse(scenario, scenario.trajectory.x2, Loop::Closed)
+    let least_stable = analyse(scenario, scenario.trajectory.x2, Loop::Closed)
         .ok()
-        .and_then(|a| a.modes.iter().map(|m| m.mode.growth).reduce(f64::max))
-        .unwrap_or(f64::NAN);
-    (end, growth)
+        .and_then(|a| {
+            a.modes
+                .into_iter()
+                .max_by(|p, q| p.mode.growth.total_cmp(&q.mode.growth))
+        });
+    (end, least_stable)
 }
 
 /// Metrics of a run of `scenario` (MODELS.md §7 and the vibration-control metrics).

@@ -4,10 +4,12 @@
 //! - `report`: the paper scenario for every available model → `REPORT.md` and `metrics.json`;
 //! - `work-precision`: error vs cost of DOPRI5 and generalised-α on the massive-cable models;
 //! - `modes`: closed- and open-loop modes of every model and the axial-damping sweep;
+//! - `control`: every controller on every model on the paper's move → the leaderboard;
 //! - `statics-sweep`: the static equilibrium over a grid of starts, counting failures.
 //!
 //! Errors are printed for a person and give a non-zero exit; a failed run keeps its output.
 
+mod control;
 mod figures;
 mod modes;
 mod output;
@@ -17,6 +19,7 @@ mod statics_sweep;
 mod work_precision;
 
 use cdpr_bench::ModelKind;
+use cdpr_bench::core::scenario::ControllerKind;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -70,9 +73,22 @@ enum Command {
         /// Scenario file (TOML, MODELS.md §9); absent = the paper's scenario.
         #[arg(long)]
         scenario: Option<PathBuf>,
+        /// Controller, overriding the scenario's `[controller] kind`.
+        #[arg(long, value_enum)]
+        controller: Option<ControllerKind>,
         /// Effector position x [m]; absent = the trajectory's x1 and x2.
         #[arg(long)]
         at: Option<f64>,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Every controller × every cable model on the paper's move with tension limits [10, 400] N:
+    /// DIR/control.md (the leaderboard and the goals), DIR/control.csv and figures.
+    Control {
+        /// Scenario file overriding the paper's (its controller kind and limits are replaced).
+        #[arg(long)]
+        scenario: Option<PathBuf>,
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
@@ -115,7 +131,13 @@ fn main() -> ExitCode {
         } => simulate::run(scenario.as_deref(), model, &out, every),
         Command::Report { out, scenario } => report::run(scenario.as_deref(), &out),
         Command::WorkPrecision { out } => work_precision::run_study(&out),
-        Command::Modes { scenario, at, out } => modes::run(scenario.as_deref(), at, &out),
+        Command::Modes {
+            scenario,
+            controller,
+            at,
+            out,
+        } => modes::run(scenario.as_deref(), controller, at, &out),
+        Command::Control { scenario, out } => control::run(scenario.as_deref(), &out),
         Command::StaticsSweep {
             scenario,
             model,

@@ -11,7 +11,7 @@ use cdpr_bench::ModelKind;
 use cdpr_bench::analysis::damping::Sweep;
 use cdpr_bench::analysis::modes::{self, Analysis, ClassifiedMode, Loop, ModeKind};
 use cdpr_bench::core::Vector2;
-use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::core::scenario::{ControllerKind, Scenario};
 use plotters::prelude::*;
 use std::io::Write;
 use std::path::Path;
@@ -68,8 +68,18 @@ pub fn compute(base: &Scenario, xs: &[f64], sweep_at: f64) -> Result<ModesReport
 }
 
 /// `cargo xtask modes`: writes modes.csv, modes.md, damping_sweep.csv and the spectrum figure(s).
-pub fn run(scenario: Option<&Path>, at: Option<f64>, out: &Path) -> Result<()> {
-    let base = crate::simulate::load_scenario(scenario, None)?;
+pub fn run(
+    scenario: Option<&Path>,
+    controller: Option<ControllerKind>,
+    at: Option<f64>,
+    out: &Path,
+) -> Result<()> {
+    let mut base = crate::simulate::load_scenario(scenario, None)?;
+    if let Some(kind) = controller {
+        base.controller.kind = kind;
+        base.trajectory.z_ref = None;
+        base.validate()?;
+    }
     let xs = match at {
         Some(x) => vec![x],
         None => vec![base.trajectory.x1, base.trajectory.x2],

@@ -107,17 +107,18 @@ impl Default for Controller {
             p_z: 1860.0,
             i_z: 8700.0,
             d_z: 100.0,
-            // Error poles (s + 60)³: 3ω, 3ω², ω³ at ω = 60 rad/s.
-            kp: 10_800.0,
-            kd: 180.0,
-            ki: 216_000.0,
-            // Well below the cables' first axial mode (≈ 5 800 rad/s), well above 60 rad/s.
-            velocity_filter: 300.0,
-            // Bryson's rule: 0.3 mm, 30 mm/s, 0.1 mm·s of error against 1 N of tension, which
-            // puts the closed-loop poles near the computed-torque's 60 rad/s.
-            q_position: 1e7,
-            q_velocity: 1e3,
-            q_integral: 1e8,
+            // Error poles (s + 100)³: 3ω, 3ω², ω³ at ω = 100 rad/s, the fastest that keeps the
+            // massive-cable loops' axial modes within 0.04 1/s of neutral (docs/control.md).
+            kp: 30_000.0,
+            kd: 300.0,
+            ki: 1_000_000.0,
+            // Well below the cables' first axial mode (≈ 5 800 rad/s), 4× above ω.
+            velocity_filter: 400.0,
+            // Bryson's rule: 32 µm, 10 mm/s, 10 µm·s of error against 1 N of tension; closed-loop
+            // poles near the computed-torque's.
+            q_position: 1e9,
+            q_velocity: 1e4,
+            q_integral: 1e10,
             r: 1.0,
         }
     }
