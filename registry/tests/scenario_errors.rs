@@ -477,3 +477,61 @@ fn random_files_validate_or_fail_cleanly() {
         refused.get()
     );
 }
+
+/// Each controller kind's own gains, the velocity filter and the tension limits: negative,
+/// non-finite or unstable values are named errors before any work starts.
+#[test]
+fn controller_kinds_refuse_bad_gains_and_limits() {
+    let cases: &[(&str, &str, &str, f64)] = &[
+        ("pid-xz", "p_z", "-1.0", -1.0),
+        ("pid-xz", "i_z", "nan", f64::NAN),
+        ("pid-xz", "d_z", "inf", f64::INFINITY),
+        ("computed-torque", "kp", "0.0", 0.0),
+        ("computed-torque", "kd", "-300.0", -300.0),
+        ("computed-torque", "ki", "-1.0", -1.0),
+        // Routh–Hurwitz: K_i must stay below K_d K_p = 300 · 30000.
+        ("computed-torque", "ki", "9e6", 9e6),
+        ("computed-torque", "velocity_filter", "0.0", 0.0),
+        ("computed-torque", "velocity_filter", "nan", f64::NAN),
+        ("lqr", "q_position", "0.0", 0.0),
+        ("lqr", "q_velocity", "-1.0", -1.0),
+        ("lqr", "q_integral", "inf", f64::INFINITY),
+        ("lqr", "r", "0.0", 0.0),
+        ("lqr", "velocity_filter", "-400.0", -400.0),
+        // t_min ≥ t_max.
+        ("lqr", "t_max", "5.0\nt_min = 5.0", 5.0),
+        // Two cables at 4 N cannot hold 9.81 N, nor the start's ΣT = 200 N.
+        ("pid", "t_max", "4.0", 4.0),
+        ("computed-torque", "t_max", "60.0", 60.0),
+    ];
+    for &(kind, name, literal, value) in cases {
+        let text = format!("[controller]\nkind = \"{kind}\"\n{name} = {literal}\n");
+        expect_out_of_range(&text, &format!("controller.{name}"), value);
+    }
+    // Gains of another kind are not judged.
+    scenario_from_toml_str("[controller]\nkind = \"pid\"\nkp = -1.0\n").unwrap();
+    // An unknown controller names the allowed ones.
+    expect_syntax(
+        "[controller]\nkind = \"mpc\"\n",
+        &["mpc", "pid-xz", "computed-torque", "lqr"],
+    );
+}
+
+/// z_ref and the controller must agree: the paper's PID cannot hold z, the others regulate it.
+#[test]
+fn z_reference_must_fit_the_controller() {
+    for (kind, z_ref) in [("pid", "hold"), ("lqr", "free"), ("pid-xz", "free")] {
+        let text = format!("[controller]\nkind = \"{kind}\"\n[trajectory]\nz_ref = \"{z_ref}\"\n");
+        let err = scenario_from_toml_str(&text).unwrap_err().to_string();
+        assert!(
+            err.contains("trajectory.z_ref") && err.contains(kind),
+            "{err}"
+        );
+    }
+    let s = scenario_from_toml_str("[controller]\nkind = \"lqr\"\n").unwrap();
+    assert_eq!(s.z_ref(), cdpr_bench::core::scenario::ZRef::Hold);
+    assert_eq!(
+        Scenario::paper().z_ref(),
+        cdpr_bench::core::scenario::ZRef::Free
+    );
+}

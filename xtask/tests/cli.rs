@@ -226,3 +226,90 @@ fn statics_sweep_outside_the_workspace_is_an_error() {
         "{stderr}"
     );
 }
+
+/// `control` runs every controller on every model (a short record, for time) and writes the
+/// leaderboard: one CSV row per pair, the paper PID's path error in millimetres and the
+/// feedforward controllers' at round-off on the elastic model, the tables and figures in
+/// control.md.
+#[test]
+fn control_writes_the_leaderboard() {
+    let dir = TempDir::new("control");
+    let scenario = dir.join("short.toml");
+    std::fs::write(&scenario, "[simulation]\nt_final = 1.5\n").unwrap();
+    let out = dir.join("out");
+    let status = xtask()
+        .args(["control", "--scenario"])
+        .arg(&scenario)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("control.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 12, "4 controllers × 3 models");
+    let path_error = |controller: &str, model: &str| -> f64 {
+        let row = rows
+            .iter()
+            .find(|r| r[0] == controller && r[1] == model)
+            .unwrap_or_else(|| panic!("no row for {controller} on {model}"));
+        row[4].parse().unwrap()
+    };
+    // The paper's 5.9 mm overshoot class of error, on every model.
+    for model in ["elastic", "lumped", "fe"] {
+        let e = path_error("pid", model);
+        assert!((5e-3..7e-3).contains(&e), "pid on {model}: {e}");
+    }
+    for controller in ["computed-torque", "lqr"] {
+        assert!(path_error(controller, "elastic") < 1e-8, "{controller}");
+        assert!(path_error(controller, "lumped") < 1e-4, "{controller}");
+    }
+    let md = std::fs::read_to_string(out.join("control.md")).unwrap();
+    for needle in [
+        "| pid | elastic |",
+        "### Goals",
+        "control_ex.svg",
+        "control_spectrum.svg",
+    ] {
+        assert!(md.contains(needle), "control.md lacks {needle}");
+    }
+    for figure in ["control_ex", "control_ez", "control_spectrum"] {
+        assert!(out.join(format!("{figure}.png")).exists(), "{figure}.png");
+    }
+}
+
+/// `modes --controller` analyses the chosen controller's loop (its states in the Jacobian).
+#[test]
+fn modes_takes_the_controller() {
+    let dir = TempDir::new("modes-controller");
+    let out = dir.join("out");
+    let status = xtask()
+        .args(["modes", "--controller", "lqr", "--at", "0.6", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("modes.csv")).unwrap();
+    // The LQR's closed elastic loop: 4 effector + 6 controller states, every mode decaying.
+    let elastic: Vec<f64> = csv
+        .lines()
+        .filter(|l| l.starts_with("elastic,closed"))
+        .map(|l| l.split(',').nth(7).unwrap().parse().unwrap())
+        .collect();
+    assert!(
+        !elastic.is_empty() && elastic.iter().all(|&g| g < 0.0),
+        "{elastic:?}"
+    );
+}
