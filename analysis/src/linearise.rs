@@ -16,6 +16,7 @@ use crate::AnalysisError;
 use crate::modes::{Analysis, ClassifiedMode, Loop, classify};
 use cdpr_core::Vector2;
 use cdpr_core::closed_loop::{Actuation, ClosedLoop};
+use cdpr_core::controller::Controller;
 use cdpr_core::model::{CableModel, Equilibrium};
 use cdpr_core::scenario::Scenario;
 use cdpr_core::trajectory::Step5;

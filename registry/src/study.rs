@@ -12,7 +12,7 @@ use cdpr_analysis::linearise::{self, EndState, Linearised};
 use cdpr_analysis::metrics::Metrics;
 use cdpr_analysis::modes::{Analysis, ClassifiedMode, Loop};
 use cdpr_core::closed_loop::ClosedLoop;
-use cdpr_core::controller::TensionLimits;
+use cdpr_core::controller::{Controller, TensionLimits};
 use cdpr_core::model::{CableModel, ModelError};
 use cdpr_core::runner::{Observer, Run, RunFailure, RunOptions, simulate_observed as simulate_run};
 use cdpr_core::scenario::{IntegratorKind, ModesChoice, Scenario, ScenarioError};

@@ -10,7 +10,7 @@ use cdpr_bench::core::channel::Channel;
 use cdpr_bench::core::closed_loop::ClosedLoop;
 use cdpr_bench::core::controller::lqr::Lqr;
 use cdpr_bench::core::controller::velocity_filter::VelocityFilter;
-use cdpr_bench::core::controller::{self, Plant, Reference, StepStart, TensionLimits};
+use cdpr_bench::core::controller::{self, Controller, Plant, Reference, StepStart, TensionLimits};
 use cdpr_bench::core::model::{CableModel, Effector};
 use cdpr_bench::core::runner::{RunOptions, simulate_from};
 use cdpr_bench::core::scenario::{ControllerKind, Scenario};

@@ -5,7 +5,7 @@
 //! [`CableModel::second_order`] (the runner checks first).
 
 use super::{ClosedLoop, Command, MAX_CONTROLLER_STATES};
-use crate::controller::{self, Reference};
+use crate::controller::{self, Controller, Reference};
 use crate::model::{CableModel, Effector};
 use cdpr_numerics::{MatrixCost, SecondOrderSystem};
 

@@ -12,7 +12,7 @@ mod implicit;
 mod rest;
 
 use crate::Vector2;
-use crate::controller::{self, Controller, Reference, TensionLimits};
+use crate::controller::{self, AnyController, Controller, Reference, TensionLimits};
 use crate::model::{CableModel, Effector};
 use crate::scenario::Scenario;
 use crate::trajectory::Step5;
@@ -52,13 +52,15 @@ pub const MAX_CONTROLLER_STATES: usize = 8;
 pub struct ClosedLoop<M: CableModel> {
     pub model: M,
     pub trajectory: Step5,
-    pub controller: Box<dyn Controller>,
+    pub controller: AnyController,
     pub limits: TensionLimits,
     pub actuation: Actuation,
     /// ΣT of the start equilibrium (MODELS.md §2) [N].
     pub tension_sum: f64,
     /// The held height z0 [m] once the start equilibrium is known (the reference's z).
     z_hold: Option<f64>,
+    /// Whether the controller reads the reference's velocity and acceleration.
+    feedforward: bool,
     /// The tensions of the last rest state ([`ClosedLoop::rest_state`]) [N].
     rest_tensions: [f64; 2],
     /// The start of the current implicit step.
@@ -72,6 +74,7 @@ impl<M: CableModel> ClosedLoop<M> {
     pub fn new(model: M, scenario: &Scenario) -> Self {
         let controller = controller::build(scenario);
         let c = controller.state_len();
+        let feedforward = controller.uses_reference_derivatives();
         debug_assert!(c <= MAX_CONTROLLER_STATES, "controller with {c} states");
         Self {
             model,
@@ -81,6 +84,7 @@ impl<M: CableModel> ClosedLoop<M> {
             actuation: Actuation::Controller,
             tension_sum: scenario.controller.tension_sum,
             z_hold: None,
+            feedforward,
             rest_tensions: [0.0; 2],
             step_start: implicit::StepStart::new(c),
             residual_scratch: Default::default(),
@@ -104,14 +108,20 @@ impl<M: CableModel> ClosedLoop<M> {
     }
 
     /// The reference at time t [s]: x, ẋ, ẍ from `step5`; z the held start height z0 (0 before
-    /// the start equilibrium is known), at rest.
+    /// the start equilibrium is known), at rest. ẋ and ẍ are 0 for controllers that do not read
+    /// them.
     #[inline]
     pub fn reference(&self, t: f64) -> Reference {
         let z = self.z_hold.unwrap_or(0.0);
+        let (v, a) = if self.feedforward {
+            (self.trajectory.velocity(t), self.trajectory.acceleration(t))
+        } else {
+            (0.0, 0.0)
+        };
         Reference {
             position: Vector2::new(self.trajectory.position(t), z),
-            velocity: Vector2::new(self.trajectory.velocity(t), 0.0),
-            acceleration: Vector2::new(self.trajectory.acceleration(t), 0.0),
+            velocity: Vector2::new(v, 0.0),
+            acceleration: Vector2::new(a, 0.0),
         }
     }
 

@@ -5,7 +5,7 @@
 
 use super::ClosedLoop;
 use crate::Vector2;
-use crate::controller::{Reference, Rest, split_tensions};
+use crate::controller::{Controller, Reference, Rest, split_tensions};
 use crate::model::{CableModel, Equilibrium, ModelError};
 
 /// Tolerance of the held height in the secant iteration [m] (a few ulps of a 0.1 m height).

@@ -124,6 +124,9 @@ impl Controller for Lqr {
     fn state_len(&self) -> usize {
         2 + velocity_filter::STATES
     }
+    fn uses_reference_derivatives(&self) -> bool {
+        true
+    }
     fn measures(&self) -> Measures {
         Measures {
             z: true,

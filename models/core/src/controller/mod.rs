@@ -106,6 +106,12 @@ pub trait Controller: Send + Sync + std::fmt::Debug {
     /// has no integral action to hold them).
     fn rest_states(&self, reference: &Reference, effector: &Effector, rest: &Rest, out: &mut [f64]);
 
+    /// Whether the controller reads the reference's velocity and acceleration (feedforward);
+    /// the loop skips computing them otherwise (the elastic RHS is ~15 ns: it shows).
+    fn uses_reference_derivatives(&self) -> bool {
+        false
+    }
+
     /// Step [m, m/s] of the differences that give the implicit iteration matrix dT/dq: a unit
     /// step is exact for controllers affine in the measurement (the paper's PID).
     fn difference_step(&self) -> f64 {
@@ -173,14 +179,96 @@ impl Plant {
 
 /// The scenario's controller. A controller designed at the held height (the LQR) is designed
 /// when the closed loop knows it ([`Controller::hold_height`]).
-pub fn build(scenario: &Scenario) -> Box<dyn Controller> {
+pub fn build(scenario: &Scenario) -> AnyController {
     let c = &scenario.controller;
     let plant = Plant::new(scenario);
     match c.kind {
-        ControllerKind::Pid => Box::new(PaperPid::from(c)),
-        ControllerKind::PidXz => Box::new(pid_xz::PidXz::new(c, plant)),
-        ControllerKind::ComputedTorque => Box::new(computed_torque::ComputedTorque::new(c, plant)),
-        ControllerKind::Lqr => Box::new(lqr::Lqr::new(scenario, plant)),
+        ControllerKind::Pid => AnyController::Pid(PaperPid::from(c)),
+        ControllerKind::PidXz => AnyController::PidXz(pid_xz::PidXz::new(c, plant)),
+        ControllerKind::ComputedTorque => {
+            AnyController::ComputedTorque(computed_torque::ComputedTorque::new(c, plant))
+        }
+        ControllerKind::Lqr => AnyController::Lqr(Box::new(lqr::Lqr::new(scenario, plant))),
+    }
+}
+
+/// Every controller, dispatched by a match rather than a virtual call: the elastic model's RHS
+/// is ~15 ns, and the compiler inlines the paper PID's arithmetic through the match (a boxed
+/// trait object cost 7.6 ns per RHS, 12.8 → 20.4 ns).
+#[derive(Debug, Clone)]
+pub enum AnyController {
+    Pid(PaperPid),
+    PidXz(pid_xz::PidXz),
+    ComputedTorque(computed_torque::ComputedTorque),
+    Lqr(Box<lqr::Lqr>),
+}
+
+macro_rules! each {
+    ($self:expr, $c:ident => $body:expr) => {
+        match $self {
+            AnyController::Pid($c) => $body,
+            AnyController::PidXz($c) => $body,
+            AnyController::ComputedTorque($c) => $body,
+            AnyController::Lqr($c) => $body,
+        }
+    };
+}
+
+impl Controller for AnyController {
+    fn kind(&self) -> ControllerKind {
+        each!(self, c => c.kind())
+    }
+    fn state_len(&self) -> usize {
+        each!(self, c => c.state_len())
+    }
+    fn measures(&self) -> Measures {
+        each!(self, c => c.measures())
+    }
+    #[inline]
+    fn output(&self, reference: &Reference, effector: &Effector, states: &[f64]) -> Output {
+        each!(self, c => c.output(reference, effector, states))
+    }
+    #[inline]
+    fn state_rate(
+        &self,
+        reference: &Reference,
+        effector: &Effector,
+        states: &[f64],
+        saturated: bool,
+        rate: &mut [f64],
+    ) {
+        each!(self, c => c.state_rate(reference, effector, states, saturated, rate))
+    }
+    fn trapezoidal_step(
+        &self,
+        h: f64,
+        start: &StepStart,
+        reference: &Reference,
+        effector: &Effector,
+        out: &mut [f64],
+    ) {
+        each!(self, c => c.trapezoidal_step(h, start, reference, effector, out))
+    }
+    fn rest_states(
+        &self,
+        reference: &Reference,
+        effector: &Effector,
+        rest: &Rest,
+        out: &mut [f64],
+    ) {
+        each!(self, c => c.rest_states(reference, effector, rest, out))
+    }
+    fn uses_reference_derivatives(&self) -> bool {
+        each!(self, c => c.uses_reference_derivatives())
+    }
+    fn difference_step(&self) -> f64 {
+        each!(self, c => c.difference_step())
+    }
+    fn hold_height(&mut self, z0: f64) -> Result<(), ControlError> {
+        each!(self, c => c.hold_height(z0))
+    }
+    fn gains(&self) -> Vec<(&'static str, Vec<f64>)> {
+        each!(self, c => c.gains())
     }
 }
 
