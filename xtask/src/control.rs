@@ -403,15 +403,58 @@ impl Leaderboard {
         Ok(names)
     }
 
-    /// Writes control.md, control.csv and the figures into `out`.
-    pub fn write(&self, out: &Path) -> Result<()> {
+    /// Writes control.md, control.csv and the figures into `out`; returns the figures' (stem,
+    /// title).
+    pub fn write(&self, out: &Path) -> Result<Vec<(String, String)>> {
         std::fs::create_dir_all(out)?;
         let names = self.figures(out)?;
         let csv = self.csv();
         write_atomic(&out.join("control.csv"), |w| w.write_all(csv.as_bytes()))?;
         let mut md = String::from("# Vibration control: every controller on every cable model\n\n");
         md.push_str(&self.section(&names));
-        write_atomic(&out.join("control.md"), |w| w.write_all(md.as_bytes()))
+        write_atomic(&out.join("control.md"), |w| w.write_all(md.as_bytes()))?;
+        Ok(names)
+    }
+
+    /// What keeps the massive-cable loops from the "no growing mode" goal, from this run's
+    /// least-stable modes.
+    fn growing_modes(&self) -> String {
+        let mut md = String::from(
+            "\n### Why a mode still grows on the massive-cable models\n\n\
+             The reels command tension at one end of each cable; the controllers measure the \
+             effector at the other. The paper's cable has no material damping, so every closed \
+             loop that feeds the effector's motion back to the reels moves the cables' undamped \
+             axial modes off the imaginary axis, to either side. The least-stable modes here:\n\n",
+        );
+        for e in &self.entries {
+            let c = &e.metrics.control;
+            if e.model != ModelKind::Elastic && c.least_stable_growth > 0.0 {
+                let _ = writeln!(
+                    md,
+                    "- {} on {}: {} at {} rad/s grows at {} 1/s (ζ = {:.1e})",
+                    e.controller.name(),
+                    e.model.name(),
+                    c.least_stable_kind,
+                    plain(c.least_stable_omega_rad_s, 0),
+                    plain(c.least_stable_growth, 4),
+                    -c.least_stable_growth
+                        / c.least_stable_growth.hypot(c.least_stable_omega_rad_s)
+                );
+            }
+        }
+        md.push_str(
+            "\nThe paper PID's derivative term (filter 540 rad/s) destabilises the first axial \
+             mode. Raw velocity feedback (computed-torque, LQR without `velocity_filter`) does so \
+             at ≈ 0.67 K_d: 20 1/s at K_d = 30 1/s, 55 1/s for the LQR. The second-order filter \
+             on the velocity error lags 180° at the first axial mode and damps it; the second \
+             axial mode, whose end-to-end phase is reversed, is left at +0.03–0.04 1/s (an \
+             e-folding time of 25–33 s, against a 5 s print move). Faster feedback reaches the \
+             10 µm goal sooner but pushes this mode harder (error poles at 120 rad/s: 5.6 µm and \
+             +0.59 1/s). Removing it needs damping the model does not have (the modes report's \
+             axial-damping sweep gives the smallest that makes every mode decay) or a controller \
+             that models the cable (none of these does: they are designed on the rigid cable).\n",
+        );
+        md
     }
 
     /// The leaderboard section (tables, stops, figures) shared with REPORT.md.
@@ -425,6 +468,7 @@ impl Leaderboard {
         md.push_str(&self.table());
         md.push_str("\n### Goals, with the best controller per model\n\n");
         md.push_str(&self.goals());
+        md.push_str(&self.growing_modes());
         let stops: Vec<String> = self
             .entries
             .iter()

@@ -131,6 +131,9 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     let (x1, x2) = (base.trajectory.x1, base.trajectory.x2);
     let modes = crate::modes::compute(&base, &[x1, x2], x2)?;
     modes.write_files(out)?;
+    // Every controller on every model (the leaderboard, ~2 s on two cores).
+    let control = crate::control::compute(&base)?;
+    let control_figures = control.write(out)?;
     write_json(
         &out.join("metrics.json"),
         &ReportFile {
@@ -148,7 +151,18 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
             checks: &checks,
         },
     )?;
-    write_markdown(&base, &outcomes, &ends, &checks, eq15, &names, &modes, out)?;
+    let control_section = control.section(&control_figures);
+    write_markdown(
+        &base,
+        &outcomes,
+        &ends,
+        &checks,
+        eq15,
+        &names,
+        &modes,
+        &control_section,
+        out,
+    )?;
     let failed = checks.iter().filter(|c| !c.pass).count();
     println!(
         "{} models, {} checks, {} failed → {}",
@@ -397,6 +411,7 @@ fn write_markdown(
     eq15: f64,
     figures: &[(String, String)],
     modes: &crate::modes::ModesReport,
+    control: &str,
     out: &Path,
 ) -> Result<()> {
     let sim = &base.simulation;
@@ -516,6 +531,14 @@ fn write_markdown(
         for o in outcomes {
             writeln!(w, "| {} | {:.2} |", o.kind, o.run.wall_s)?;
         }
+
+        writeln!(
+            w,
+            "\n## Vibration control: every controller on every cable model\n\n\
+             Beyond the paper: its PID and three controllers that act on z (`cargo xtask control`; \
+             control.csv has every number).\n"
+        )?;
+        w.write_all(control.as_bytes())?;
 
         writeln!(w, "\n## Figures\n")?;
         for (name, caption) in figures {
