@@ -91,6 +91,32 @@ fn slack_cable_stops_the_run_with_time_and_cable() {
     );
 }
 
+/// A run whose effector leaves the workspace (here pulled up through the pulleys' line by 5 kN
+/// per cable) stops with the time and position instead of integrating a robot that no longer
+/// exists; the samples before are kept. (An unstable loop on the FE model once ran on to
+/// x = −136 m without a word.)
+#[test]
+fn leaving_the_workspace_stops_the_run() {
+    use cdpr_bench::core::closed_loop::{Actuation, ClosedLoop};
+    use cdpr_bench::core::runner::{RunOptions, simulate};
+    use cdpr_bench::elastic::Elastic;
+    let scenario = Scenario::paper();
+    let mut sys = ClosedLoop::new(Elastic::new(&scenario), &scenario);
+    sys.actuation = Actuation::Prescribed(Box::new(|_| [5000.0, 5000.0]));
+    let mut opts = RunOptions::from(&scenario);
+    opts.t_final = 0.1;
+    let failure = simulate(&mut sys, &opts, &mut |_| {}).unwrap_err();
+    let RunError::Workspace { t, x, z, .. } = failure.error else {
+        panic!("expected the workspace error, got {:?}", failure.error);
+    };
+    // From z0 ≈ −0.0247 m at rest, ≈ 400 m/s² upward: the line z = 0 is crossed after ~11 ms.
+    assert!(t > 0.005 && t < 0.02, "t = {t}");
+    assert!(z >= 0.0 && x > 0.0, "({x}, {z})");
+    assert!(failure.to_string().contains("left the workspace"));
+    let partial = failure.partial.expect("output kept");
+    assert!(partial.series.len() > 100);
+}
+
 /// A model parameter outside the model's domain is a clear error naming the key, before any work
 /// starts (here a lumped cable of 2 elements: no reel end, straddling spring and free node at
 /// once), from the scenario file, from a scenario built in code, and from the model's own

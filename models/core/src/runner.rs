@@ -25,6 +25,17 @@ pub enum RunError {
         #[source]
         source: IntegratorError,
     },
+    /// The effector left the workspace below the pulleys, 0 < x < d, z < 0 (a run gone
+    /// unstable: its numbers past here describe no robot).
+    #[error(
+        "the effector left the workspace at t = {t} s: (x, z) = ({x}, {z}) m, allowed 0 < x < {anchor_distance} m and z < 0"
+    )]
+    Workspace {
+        t: f64,
+        x: f64,
+        z: f64,
+        anchor_distance: f64,
+    },
     /// A commanded tension ≤ 0 (MODELS.md §2): a cable cannot push.
     #[error("cable {cable} went slack at t = {t} s: commanded tension {tension} N ≤ 0")]
     SlackCable { t: f64, cable: usize, tension: f64 },
@@ -545,6 +556,15 @@ impl Sampler {
             check_slack(tk, cmd.tensions)?;
             let model_state = &y[..n];
             let eff = sys.model.effector(model_state);
+            let (x, z, d) = (eff.position.x, eff.position.y, sys.anchor_distance);
+            if !(x > 0.0 && x < d && z < 0.0) {
+                return Err(RunError::Workspace {
+                    t: tk,
+                    x,
+                    z,
+                    anchor_distance: d,
+                });
+            }
             let energy = sys.model.energy(model_state);
             let c = n + sys.controller_len();
             let (work, dissipated) = (y[c], y[c + 1]);

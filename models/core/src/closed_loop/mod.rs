@@ -57,6 +57,8 @@ pub struct ClosedLoop<M: CableModel> {
     pub actuation: Actuation,
     /// ΣT of the start equilibrium (MODELS.md §2) [N].
     pub tension_sum: f64,
+    /// Pulley distance d [m]: the runner stops a run whose effector leaves 0 < x < d, z < 0.
+    pub anchor_distance: f64,
     /// The held height z0 [m] once the start equilibrium is known (the reference's z).
     z_hold: Option<f64>,
     /// Whether the controller reads the reference's velocity and acceleration.
@@ -83,6 +85,7 @@ impl<M: CableModel> ClosedLoop<M> {
             limits: TensionLimits::from(&scenario.controller),
             actuation: Actuation::Controller,
             tension_sum: scenario.controller.tension_sum,
+            anchor_distance: scenario.robot.anchor_distance,
             z_hold: None,
             feedforward,
             rest_tensions: [0.0; 2],
