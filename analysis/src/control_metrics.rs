@@ -27,6 +27,10 @@ pub struct ControlContext<'a> {
     pub limits: TensionLimits,
     /// Sample period [s].
     pub sample_period: f64,
+    /// The input shaper: its name, design frequency [rad/s] and damping ratio (NaN unshaped).
+    pub shaper: &'a str,
+    pub shaper_frequency: f64,
+    pub shaper_damping: f64,
 }
 
 /// Keys of `metrics.json` (SI units, in [`crate::metrics::UNITS`]; NaN is null).
@@ -53,6 +57,12 @@ pub struct ControlMetrics {
     /// That mode's frequency [rad/s] and kind ("axial cable 2", …; empty where not done).
     pub least_stable_omega_rad_s: f64,
     pub least_stable_kind: String,
+    /// The input shaper ("none", "zv", …), the mode it was designed for (natural frequency
+    /// [rad/s], damping ratio; null unshaped) and when the shaped reference reaches x2 [s].
+    pub shaper: String,
+    pub shaper_frequency_rad_s: f64,
+    pub shaper_damping: f64,
+    pub move_end_s: f64,
     /// The controller's designed gains (the LQR's K, row-major 2 × 6, …).
     pub controller_gains: BTreeMap<String, Vec<f64>>,
 }
@@ -103,6 +113,10 @@ impl ControlMetrics {
             least_stable_growth: f64::NAN,
             least_stable_omega_rad_s: f64::NAN,
             least_stable_kind: String::new(),
+            shaper: context.shaper.to_owned(),
+            shaper_frequency_rad_s: context.shaper_frequency,
+            shaper_damping: context.shaper_damping,
+            move_end_s: context.move_end,
             controller_gains: BTreeMap::new(),
         }
     }

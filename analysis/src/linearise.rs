@@ -19,6 +19,7 @@ use cdpr_core::closed_loop::{Actuation, ClosedLoop};
 use cdpr_core::controller::Controller;
 use cdpr_core::model::{CableModel, Equilibrium};
 use cdpr_core::scenario::Scenario;
+use cdpr_core::shaper::Impulses;
 use cdpr_core::trajectory::Step5;
 use cdpr_numerics::differences::{jacobian, jacobian_within};
 use cdpr_numerics::eigen::{Mode, mode_shapes, modes, nearest_mode, reduce};
@@ -61,6 +62,7 @@ pub fn linearise<M: CableModel>(
         x2: x,
         ..sys.trajectory
     };
+    sys.shaper = Some(Impulses::none());
     let (y, eq) = sys.rest_state(x)?;
     let tensions = sys.rest_tensions();
     if feedback == Loop::Open {
@@ -164,6 +166,8 @@ pub fn end_state<M: CableModel>(
     omega_guess: f64,
 ) -> Result<EndState, AnalysisError> {
     check_size(sys.dynamic_len())?;
+    // At rest at x2: the reference there, unshaped.
+    sys.shaper = Some(Impulses::none());
     let (y, eq) = sys.rest_state(sys.trajectory.x2)?;
     // After t2 the reference is constant: the loop is autonomous there.
     let t = sys.trajectory.t2 + 1.0;

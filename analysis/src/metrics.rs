@@ -203,6 +203,10 @@ pub const UNITS: &[(&str, &str)] = &[
     ("least_stable_growth", "1/s"),
     ("least_stable_omega_rad_s", "rad/s"),
     ("least_stable_kind", ""),
+    ("shaper", ""),
+    ("shaper_frequency_rad_s", "rad/s"),
+    ("shaper_damping", ""),
+    ("move_end_s", "s"),
     ("controller_gains", "SI"),
 ];
 

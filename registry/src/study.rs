@@ -10,12 +10,13 @@ use cdpr_analysis::control_metrics::ControlContext;
 use cdpr_analysis::damping::{self, Sweep};
 use cdpr_analysis::linearise::{self, EndState, Linearised};
 use cdpr_analysis::metrics::Metrics;
-use cdpr_analysis::modes::{Analysis, ClassifiedMode, Loop};
+use cdpr_analysis::modes::{Analysis, ClassifiedMode, Loop, ModeKind};
 use cdpr_core::closed_loop::ClosedLoop;
 use cdpr_core::controller::{Controller, TensionLimits};
 use cdpr_core::model::{CableModel, ModelError};
 use cdpr_core::runner::{Observer, Run, RunFailure, RunOptions, simulate_observed as simulate_run};
-use cdpr_core::scenario::{IntegratorKind, ModesChoice, Scenario, ScenarioError};
+use cdpr_core::scenario::{Designed, IntegratorKind, ModesChoice, Scenario, ScenarioError};
+use cdpr_core::shaper::ShaperKind;
 use cdpr_core::trajectory::Step5;
 use cdpr_elastic::eq15_frequency;
 use cdpr_numerics::AlphaCoefficients;
@@ -44,6 +45,7 @@ impl From<BuildError> for Error {
 
 /// As [`simulate`], watched and steered by `observer` (progress, each sample, a stop flag).
 pub fn simulate_observed(scenario: &Scenario, observer: &mut Observer) -> Result<Run, Error> {
+    let scenario = &resolve_shaper(scenario)?;
     let mut sys = ClosedLoop::new(build(scenario)?, scenario);
     Ok(simulate_run(
         &mut sys,
@@ -121,6 +123,7 @@ pub fn assess(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Asse
 
 /// As [`assess`], watched and steered by `observer`.
 pub fn assess_observed(scenario: &Scenario, observer: &mut Observer) -> Result<Assessed, Error> {
+    let scenario = &resolve_shaper(scenario)?;
     let kind = ModelConfig::from_scenario(scenario)?.kind;
     let run = simulate_observed(scenario, observer)?;
     let (end, least_stable) = end_analysis_and_growth(scenario);
@@ -143,9 +146,11 @@ impl Assessed {
     /// What can be measured of a run that stopped early: its metrics over the samples taken; the
     /// end's modal analysis is skipped.
     pub fn partial(scenario: &Scenario, kind: ModelKind, run: Run) -> Self {
+        // The run used the resolved shaper; resolving again repeats the same modal analysis.
+        let resolved = resolve_shaper(scenario).unwrap_or_else(|_| scenario.clone());
         Self {
             kind,
-            metrics: metrics(scenario, &run),
+            metrics: metrics(&resolved, &run),
             end: EndAnalysis::Skipped {
                 reason: format!("the run stopped at t = {} s", run.t_reached),
             },
@@ -189,19 +194,67 @@ pub fn end_analysis_and_growth(scenario: &Scenario) -> (EndAnalysis, Option<Clas
     (end, least_stable)
 }
 
-/// Metrics of a run of `scenario` (MODELS.md §7 and the vibration-control metrics).
+/// Metrics of a run of `scenario` (MODELS.md §7 and the vibration-control metrics); the
+/// scenario's shaper as resolved for the run ([`resolve_shaper`]).
 pub fn metrics(scenario: &Scenario, run: &Run) -> Metrics {
     let step5 = Step5::from(&scenario.trajectory);
+    let t = &scenario.trajectory;
+    let impulses = t.impulses().ok().flatten();
+    let shaped = t.shaper != ShaperKind::None;
+    let design = |d: Designed| {
+        if shaped {
+            d.value().unwrap_or(f64::NAN)
+        } else {
+            f64::NAN
+        }
+    };
     let context = ControlContext {
         controller: scenario.controller.kind.name(),
         move_start: step5.t1,
-        move_end: step5.t2,
+        move_end: step5.t2 + impulses.map_or(0.0, |i| i.duration()),
         limits: TensionLimits::from(&scenario.controller),
         sample_period: scenario.simulation.sample_period,
+        shaper: t.shaper.name(),
+        shaper_frequency: design(t.shaper_frequency),
+        shaper_damping: design(t.shaper_damping),
     };
     let mut metrics = Metrics::from_run(run, &step5, scenario.simulation.sample_period, &context);
     metrics.control.controller_gains = controller_gains(scenario);
     metrics
+}
+
+/// The scenario with its shaper's "auto" design values replaced by the least-damped vertical
+/// mode of the model's closed loop at x2 (natural frequency |λ| and damping ratio −σ/|λ|, a
+/// growing mode's taken as 0), from the modal analysis of the unshaped loop; unchanged when
+/// nothing is "auto".
+pub fn resolve_shaper(scenario: &Scenario) -> Result<Scenario, Error> {
+    let t = &scenario.trajectory;
+    let auto = t.shaper_frequency.value().is_none() || t.shaper_damping.value().is_none();
+    if t.shaper == ShaperKind::None || !auto {
+        return Ok(scenario.clone());
+    }
+    let mut unshaped = scenario.clone();
+    unshaped.trajectory.shaper = ShaperKind::None;
+    let analysis = analyse(&unshaped, t.x2, Loop::Closed)?;
+    let mode = analysis
+        .modes
+        .iter()
+        .filter(|m| m.kind == ModeKind::Vertical && m.mode.omega > 0.0)
+        .min_by(|a, b| {
+            let zeta = |m: &ClassifiedMode| m.mode.damping_ratio().abs();
+            zeta(a).total_cmp(&zeta(b))
+        })
+        .ok_or(AnalysisError::NoMode)?;
+    let mut resolved = scenario.clone();
+    let r = &mut resolved.trajectory;
+    if r.shaper_frequency.value().is_none() {
+        r.shaper_frequency = Designed::Value(mode.mode.growth.hypot(mode.mode.omega));
+    }
+    if r.shaper_damping.value().is_none() {
+        r.shaper_damping = Designed::Value(mode.mode.damping_ratio().max(0.0));
+    }
+    resolved.validate()?;
+    Ok(resolved)
 }
 
 /// The gains the scenario's controller designs for itself (the LQR's K at the start

@@ -18,6 +18,7 @@ pub mod runner;
 pub mod scenario;
 pub mod second_order;
 pub mod series;
+pub mod shaper;
 pub mod statics;
 pub mod trajectory;
 

@@ -36,6 +36,12 @@ pub enum RunError {
         z: f64,
         anchor_distance: f64,
     },
+    /// The shaper's design is still "auto": the modal analysis must resolve it first.
+    #[error(
+        "trajectory.shaper_frequency / shaper_damping = \"auto\" are not resolved: the registry's \
+         simulate designs the shaper from the modal analysis before a run"
+    )]
+    UnresolvedShaper,
     /// A commanded tension ≤ 0 (MODELS.md §2): a cable cannot push.
     #[error("cable {cable} went slack at t = {t} s: commanded tension {tension} N ≤ 0")]
     SlackCable { t: f64, cable: usize, tension: f64 },
@@ -323,24 +329,25 @@ fn integrate_and_sample<M: CableModel>(
             &mut alpha
         }
     };
-    let outcome =
-        if opts.integrator == IntegratorKind::Implicit && sys.model.second_order().is_none() {
-            Err(RunError::Unsupported {
-                integrator: IntegratorKind::Implicit.name(),
-                model: sys.model.name(),
-                why: "the model offers no second-order form",
-            })
-        } else {
-            integrate(
-                sys,
-                &y0,
-                opts.t_final,
-                stepper,
-                &mut sampler,
-                &mut events,
-                observer,
-            )
-        };
+    let outcome = if sys.shaper.is_none() {
+        Err(RunError::UnresolvedShaper)
+    } else if opts.integrator == IntegratorKind::Implicit && sys.model.second_order().is_none() {
+        Err(RunError::Unsupported {
+            integrator: IntegratorKind::Implicit.name(),
+            model: sys.model.name(),
+            why: "the model offers no second-order form",
+        })
+    } else {
+        integrate(
+            sys,
+            &y0,
+            opts.t_final,
+            stepper,
+            &mut sampler,
+            &mut events,
+            observer,
+        )
+    };
     let t_reached = if stepper.stats().rhs_evals == 0 {
         0.0
     } else {

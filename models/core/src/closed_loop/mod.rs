@@ -15,6 +15,7 @@ use crate::Vector2;
 use crate::controller::{self, AnyController, Controller, Reference, TensionLimits};
 use crate::model::{CableModel, Effector};
 use crate::scenario::Scenario;
+use crate::shaper::Impulses;
 use crate::trajectory::Step5;
 use cdpr_numerics::OdeSystem;
 
@@ -52,6 +53,9 @@ pub const MAX_CONTROLLER_STATES: usize = 8;
 pub struct ClosedLoop<M: CableModel> {
     pub model: M,
     pub trajectory: Step5,
+    /// The input shaper the move is convolved with (one unit impulse: unshaped); None while
+    /// the scenario's shaper design is still "auto" (the runner refuses to run then).
+    pub shaper: Option<Impulses>,
     pub controller: AnyController,
     pub limits: TensionLimits,
     pub actuation: Actuation,
@@ -81,6 +85,7 @@ impl<M: CableModel> ClosedLoop<M> {
         Self {
             model,
             trajectory: Step5::from(&scenario.trajectory),
+            shaper: scenario.trajectory.impulses().ok().flatten(),
             controller,
             limits: TensionLimits::from(&scenario.controller),
             actuation: Actuation::Controller,
@@ -116,16 +121,31 @@ impl<M: CableModel> ClosedLoop<M> {
     #[inline]
     pub fn reference(&self, t: f64) -> Reference {
         let z = self.z_hold.unwrap_or(0.0);
-        let (v, a) = if self.feedforward {
-            (self.trajectory.velocity(t), self.trajectory.acceleration(t))
-        } else {
-            (0.0, 0.0)
+        let step = &self.trajectory;
+        let (x, v, a) = match &self.shaper {
+            Some(shaper) if !shaper.is_none() => {
+                // step5 convolved with the impulses: Σ A_i step5(t − t_i).
+                let x = shaper.convolve(t, |t| step.position(t));
+                if self.feedforward {
+                    let v = shaper.convolve(t, |t| step.velocity(t));
+                    (x, v, shaper.convolve(t, |t| step.acceleration(t)))
+                } else {
+                    (x, 0.0, 0.0)
+                }
+            }
+            _ if self.feedforward => (step.position(t), step.velocity(t), step.acceleration(t)),
+            _ => (step.position(t), 0.0, 0.0),
         };
         Reference {
-            position: Vector2::new(self.trajectory.position(t), z),
+            position: Vector2::new(x, z),
             velocity: Vector2::new(v, 0.0),
             acceleration: Vector2::new(a, 0.0),
         }
+    }
+
+    /// When the (shaped) reference reaches x2 [s]: t2 plus the shaper's duration.
+    pub fn move_end(&self) -> f64 {
+        self.trajectory.t2 + self.shaper.as_ref().map_or(0.0, Impulses::duration)
     }
 
     /// The held start height z0 [m], once [`ClosedLoop::initial_state`] has found it.

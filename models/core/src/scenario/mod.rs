@@ -8,6 +8,8 @@ use serde::Deserialize;
 
 mod controller;
 pub use controller::{Controller, ControllerKind};
+
+use crate::shaper::{Impulses, ShaperKind};
 use std::fmt;
 use std::path::Path;
 
@@ -137,6 +139,78 @@ pub struct Trajectory {
     /// [`ZRef::Free`]; see [`Scenario::z_ref`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub z_ref: Option<ZRef>,
+    /// The input shaper the move is convolved with ([`crate::shaper`]).
+    #[serde(skip_serializing_if = "is_default")]
+    pub shaper: ShaperKind,
+    /// The shaped mode's natural frequency [rad/s], or "auto": the least-damped vertical mode
+    /// of the model's closed loop at x2.
+    #[serde(skip_serializing_if = "is_default")]
+    pub shaper_frequency: Designed,
+    /// The shaped mode's damping ratio, or "auto" (that mode's).
+    #[serde(skip_serializing_if = "is_default")]
+    pub shaper_damping: Designed,
+    /// The EI family's tolerated residual vibration V_tol (0, 1).
+    #[serde(skip_serializing_if = "is_default_vtol")]
+    pub shaper_vtol: f64,
+}
+
+fn is_default<T: Default + PartialEq>(v: &T) -> bool {
+    *v == T::default()
+}
+
+fn is_default_vtol(v: &f64) -> bool {
+    *v == DEFAULT_VTOL
+}
+
+/// Tolerated residual vibration of the EI shapers unless given (firmware's 5 %).
+pub const DEFAULT_VTOL: f64 = 0.05;
+
+/// A shaper design value: a number, or "auto" (from the modal analysis).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, serde::Serialize)]
+#[serde(untagged)]
+pub enum Designed {
+    Value(f64),
+    Auto(AutoWord),
+}
+
+/// The word `"auto"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum AutoWord {
+    #[default]
+    Auto,
+}
+
+impl Default for Designed {
+    fn default() -> Self {
+        Designed::Auto(AutoWord::Auto)
+    }
+}
+
+impl Designed {
+    /// The value, or None for "auto".
+    pub fn value(self) -> Option<f64> {
+        match self {
+            Designed::Value(v) => Some(v),
+            Designed::Auto(_) => None,
+        }
+    }
+}
+
+impl Trajectory {
+    /// The shaper's impulses: the unshaped move for `shaper = "none"`; `Ok(None)` while a design
+    /// value is still "auto" (the registry resolves it from the modal analysis).
+    pub fn impulses(&self) -> Result<Option<Impulses>, ScenarioError> {
+        if self.shaper == ShaperKind::None {
+            return Ok(Some(Impulses::none()));
+        }
+        match (self.shaper_frequency.value(), self.shaper_damping.value()) {
+            (Some(omega), Some(zeta)) => {
+                Impulses::design(self.shaper, omega, zeta, self.shaper_vtol).map(Some)
+            }
+            _ => Ok(None),
+        }
+    }
 }
 
 /// The reference of the effector's height.
@@ -159,6 +233,10 @@ impl Default for Trajectory {
             t1: 0.0,
             t2: 0.2,
             z_ref: None,
+            shaper: ShaperKind::None,
+            shaper_frequency: Designed::default(),
+            shaper_damping: Designed::default(),
+            shaper_vtol: DEFAULT_VTOL,
         }
     }
 }
@@ -357,6 +435,16 @@ impl Scenario {
                 ));
             }
             _ => {}
+        }
+
+        // The shaper's design values, where given (the zeros of "auto" only to check the others).
+        if t.shaper != ShaperKind::None {
+            Impulses::design(
+                t.shaper,
+                t.shaper_frequency.value().unwrap_or(1.0),
+                t.shaper_damping.value().unwrap_or(0.0),
+                t.shaper_vtol,
+            )?;
         }
 
         let s = &self.simulation;
