@@ -14,8 +14,6 @@ use cdpr_bench::{Assessed, ModelKind};
 use plotters::style::RGBColor;
 use std::fmt::Write as _;
 use std::path::Path;
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The benchmark's tension limits [N].
 pub const T_MIN: f64 = 10.0;
@@ -68,41 +66,18 @@ pub fn scenario(base: &Scenario, controller: ControllerKind, model: ModelKind) -
 
 /// Runs the leaderboard on all cores (one run per thread at a time).
 pub fn compute(base: &Scenario) -> Result<Leaderboard> {
-    let jobs: Vec<(ControllerKind, ModelKind)> = ModelKind::ALL
+    let jobs = ModelKind::ALL
         .into_iter()
         .flat_map(|m| ControllerKind::ALL.into_iter().map(move |c| (c, m)))
-        .collect();
-    let scenarios = jobs
-        .iter()
-        .map(|&(c, m)| scenario(base, c, m))
+        .map(|(c, m)| Ok((c, m, scenario(base, c, m)?)))
         .collect::<Result<Vec<_>>>()?;
-    let next = AtomicUsize::new(0);
-    let results: Vec<Mutex<Option<Result<Entry>>>> =
-        jobs.iter().map(|_| Mutex::new(None)).collect();
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
-    std::thread::scope(|scope| {
-        for _ in 0..workers.min(jobs.len()) {
-            scope.spawn(|| {
-                loop {
-                    let k = next.fetch_add(1, Ordering::SeqCst);
-                    let Some(&(c, m)) = jobs.get(k) else { break };
-                    let entry = run_one(&scenarios[k], c, m);
-                    eprintln!("control: {} on {} done", c.name(), m.name());
-                    if let Ok(mut slot) = results[k].lock() {
-                        *slot = Some(entry);
-                    }
-                }
-            });
-        }
-    });
-    let entries = results
-        .into_iter()
-        .map(|slot| {
-            slot.into_inner()
-                .map_err(|_| anyhow!("a worker panicked"))?
-                .ok_or_else(|| anyhow!("a run was not made"))?
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let entries = crate::pool::map(&jobs, |(c, m, s)| {
+        let entry = run_one(s, *c, *m);
+        eprintln!("control: {} on {} done", c.name(), m.name());
+        entry
+    })?
+    .into_iter()
+    .collect::<Result<Vec<_>>>()?;
     Ok(Leaderboard {
         entries,
         move_end: base.trajectory.t2,

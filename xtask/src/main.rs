@@ -5,6 +5,7 @@
 //! - `work-precision`: error vs cost of DOPRI5 and generalised-α on the massive-cable models;
 //! - `modes`: closed- and open-loop modes of every model and the axial-damping sweep;
 //! - `control`: every controller on every model on the paper's move → the leaderboard;
+//! - `shaping`: every input shaper on every model with the paper's PID → residuals and robustness;
 //! - `statics-sweep`: the static equilibrium over a grid of starts, counting failures.
 //!
 //! Errors are printed for a person and give a non-zero exit; a failed run keeps its output.
@@ -13,7 +14,9 @@ mod control;
 mod figures;
 mod modes;
 mod output;
+mod pool;
 mod report;
+mod shaping;
 mod simulate;
 mod statics_sweep;
 mod work_precision;
@@ -93,6 +96,17 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Every input shaper on every cable model with the paper's PID, designed from the modal
+    /// analysis: residual vibration, move-time penalty, robustness to frequency error →
+    /// DIR/shaping.md, DIR/shaping.csv and a figure per model.
+    Shaping {
+        /// Scenario file overriding the paper's (its shaper keys are replaced).
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// The static equilibrium (MODELS.md §2) at every start of an x × ΣT grid (cell midpoints);
     /// prints the starts that fail and exits non-zero if any does. The defaults are the lumped
     /// property test's ranges at 2000 × 250 points (~2 min for lumped or FE).
@@ -138,6 +152,7 @@ fn main() -> ExitCode {
             out,
         } => modes::run(scenario.as_deref(), controller, at, &out),
         Command::Control { scenario, out } => control::run(scenario.as_deref(), &out),
+        Command::Shaping { scenario, out } => shaping::run_study(scenario.as_deref(), &out),
         Command::StaticsSweep {
             scenario,
             model,

@@ -134,6 +134,9 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     // Every controller on every model (the leaderboard, ~2 s on two cores).
     let control = crate::control::compute(&base)?;
     let control_figures = control.write(out)?;
+    // Every input shaper on every model with the paper's PID (~40 s on two cores).
+    let shaping = crate::shaping::compute(&base)?;
+    let shaping_figures = shaping.write(out)?;
     write_json(
         &out.join("metrics.json"),
         &ReportFile {
@@ -151,7 +154,12 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
             checks: &checks,
         },
     )?;
-    let control_section = control.section(&control_figures);
+    let control_section = format!(
+        "{}\n## Input shaping with the paper's PID\n\nBeyond the paper (`cargo xtask shaping`; shaping.csv has \
+         every run).\n\n{}",
+        control.section(&control_figures),
+        shaping.section(&shaping_figures)
+    );
     write_markdown(
         &base,
         &outcomes,
