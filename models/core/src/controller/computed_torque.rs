@@ -12,10 +12,9 @@
 //! ∫e_x, ∫e_z, then the filter's four). Anti-windup: the integrals hold while the command is
 //! clamped.
 
-use super::velocity_filter::{self, VelocityFilter};
-use super::{
-    Controller, Measures, Output, Plant, Reference, Rest, StepStart, integrate_trapezoidal,
-};
+use super::error_states::{self, ErrorStates};
+use super::velocity_filter::VelocityFilter;
+use super::{Controller, Measures, Output, Plant, Reference, Rest, StepStart};
 use crate::Vector2;
 use crate::model::Effector;
 use crate::scenario::{self, ControllerKind};
@@ -29,8 +28,8 @@ pub struct ComputedTorque {
     pub kd: f64,
     /// K_i [1/s³].
     pub ki: f64,
-    /// The low-pass on the velocity error.
-    pub filter: VelocityFilter,
+    /// The integral and filtered-velocity error states.
+    pub errors: ErrorStates,
     pub plant: Plant,
 }
 
@@ -40,8 +39,10 @@ impl ComputedTorque {
             kp: c.kp,
             kd: c.kd,
             ki: c.ki,
-            filter: VelocityFilter {
-                omega: c.velocity_filter,
+            errors: ErrorStates {
+                filter: VelocityFilter {
+                    omega: c.velocity_filter,
+                },
             },
             plant,
         }
@@ -55,12 +56,8 @@ impl ComputedTorque {
         states: &[f64],
     ) -> Vector2<f64> {
         let e = reference.position - effector.position;
-        let raw = reference.velocity - effector.velocity;
-        let de = Vector2::new(
-            self.filter.output(&states[2..], 0, raw.x),
-            self.filter.output(&states[2..], 1, raw.y),
-        );
-        let sigma = Vector2::new(states[0], states[1]);
+        let de = self.errors.velocity_error(reference, effector, states);
+        let sigma = ErrorStates::integral(states);
         reference.acceleration + self.kd * de + self.kp * e + self.ki * sigma
     }
 }
@@ -70,7 +67,7 @@ impl Controller for ComputedTorque {
         ControllerKind::ComputedTorque
     }
     fn state_len(&self) -> usize {
-        2 + velocity_filter::STATES
+        error_states::STATES
     }
     fn uses_reference_derivatives(&self) -> bool {
         true
@@ -96,12 +93,8 @@ impl Controller for ComputedTorque {
         saturated: bool,
         rate: &mut [f64],
     ) {
-        let e = reference.position - effector.position;
-        let de = reference.velocity - effector.velocity;
-        let gate = if saturated { 0.0 } else { 1.0 };
-        rate[0] = gate * e.x;
-        rate[1] = gate * e.y;
-        self.filter.rate(&states[2..], [de.x, de.y], &mut rate[2..]);
+        self.errors
+            .rate(reference, effector, states, saturated, rate);
     }
     fn trapezoidal_step(
         &self,
@@ -111,32 +104,17 @@ impl Controller for ComputedTorque {
         effector: &Effector,
         out: &mut [f64],
     ) {
-        let e0 = start.reference.position - start.effector.position;
-        let e1 = reference.position - effector.position;
-        integrate_trapezoidal(
-            start.states,
-            [e0.x, e0.y],
-            [e1.x, e1.y],
-            h,
-            start.saturated,
-            out,
-        );
-        let de0 = start.reference.velocity - start.effector.velocity;
-        let de1 = reference.velocity - effector.velocity;
-        self.filter.trapezoidal_step(
-            &start.states[2..],
-            [de0.x, de0.y],
-            [de1.x, de1.y],
-            h,
-            &mut out[2..],
-        );
+        self.errors
+            .trapezoidal_step(h, start, reference, effector, out);
     }
     fn rest_states(&self, _: &Reference, effector: &Effector, rest: &Rest, out: &mut [f64]) {
         // At rest the integral supplies what the rigid-cable statics miss (the cables' weight).
         let a = self.plant.acceleration(effector.position, rest.tensions);
-        for k in 0..2 {
-            out[k] = if self.ki > 0.0 { a[k] / self.ki } else { 0.0 };
-        }
-        out[2..2 + velocity_filter::STATES].fill(0.0);
+        let sigma = if self.ki > 0.0 {
+            a / self.ki
+        } else {
+            Vector2::zeros()
+        };
+        ErrorStates::rest(sigma, out);
     }
 }

@@ -15,10 +15,11 @@
 //! [`VelocityFilter`] (the design ignores the filter: its corner lies far above the loop's
 //! poles). Anti-windup: the integrals hold while the command is clamped.
 
-use super::velocity_filter::{self, VelocityFilter};
+use super::error_states::{self, ErrorStates};
+use super::velocity_filter::VelocityFilter;
 use super::{
     ControlError, Controller, Measures, Output, Plant, Reference, Rest, StepStart,
-    geometric_stiffness, integrate_trapezoidal, structure_matrix,
+    geometric_stiffness, structure_matrix,
 };
 use crate::Vector2;
 use crate::model::Effector;
@@ -38,8 +39,8 @@ pub struct Lqr {
     /// max |residual| of the CARE at the returned X.
     pub care_residual: f64,
     pub plant: Plant,
-    /// The low-pass on the velocity error.
-    pub filter: VelocityFilter,
+    /// The integral and filtered-velocity error states.
+    pub errors: ErrorStates,
     weights: [f64; 4],
 }
 
@@ -53,8 +54,10 @@ impl Lqr {
             design_point: Vector2::new(scenario.trajectory.x2, f64::NAN),
             care_residual: f64::NAN,
             plant,
-            filter: VelocityFilter {
-                omega: c.velocity_filter,
+            errors: ErrorStates {
+                filter: VelocityFilter {
+                    omega: c.velocity_filter,
+                },
             },
             weights: [c.q_position, c.q_velocity, c.q_integral, c.r],
         }
@@ -110,10 +113,8 @@ impl Lqr {
 
     fn xi(&self, reference: &Reference, effector: &Effector, states: &[f64]) -> SMatrix<f64, 6, 1> {
         let e = reference.position - effector.position;
-        let raw = reference.velocity - effector.velocity;
-        let de_x = self.filter.output(&states[2..], 0, raw.x);
-        let de_z = self.filter.output(&states[2..], 1, raw.y);
-        SMatrix::<f64, 6, 1>::from([e.x, e.y, de_x, de_z, states[0], states[1]])
+        let de = self.errors.velocity_error(reference, effector, states);
+        SMatrix::<f64, 6, 1>::from([e.x, e.y, de.x, de.y, states[0], states[1]])
     }
 }
 
@@ -122,7 +123,7 @@ impl Controller for Lqr {
         ControllerKind::Lqr
     }
     fn state_len(&self) -> usize {
-        2 + velocity_filter::STATES
+        error_states::STATES
     }
     fn uses_reference_derivatives(&self) -> bool {
         true
@@ -153,12 +154,8 @@ impl Controller for Lqr {
         saturated: bool,
         rate: &mut [f64],
     ) {
-        let e = reference.position - effector.position;
-        let de = reference.velocity - effector.velocity;
-        let gate = if saturated { 0.0 } else { 1.0 };
-        rate[0] = gate * e.x;
-        rate[1] = gate * e.y;
-        self.filter.rate(&states[2..], [de.x, de.y], &mut rate[2..]);
+        self.errors
+            .rate(reference, effector, states, saturated, rate);
     }
     fn trapezoidal_step(
         &self,
@@ -168,25 +165,8 @@ impl Controller for Lqr {
         effector: &Effector,
         out: &mut [f64],
     ) {
-        let e0 = start.reference.position - start.effector.position;
-        let e1 = reference.position - effector.position;
-        integrate_trapezoidal(
-            start.states,
-            [e0.x, e0.y],
-            [e1.x, e1.y],
-            h,
-            start.saturated,
-            out,
-        );
-        let de0 = start.reference.velocity - start.effector.velocity;
-        let de1 = reference.velocity - effector.velocity;
-        self.filter.trapezoidal_step(
-            &start.states[2..],
-            [de0.x, de0.y],
-            [de1.x, de1.y],
-            h,
-            &mut out[2..],
-        );
+        self.errors
+            .trapezoidal_step(h, start, reference, effector, out);
     }
     fn rest_states(&self, reference: &Reference, _: &Effector, rest: &Rest, out: &mut [f64]) {
         // K_σ σ = T_rest − T_ff at zero error.
@@ -198,9 +178,7 @@ impl Controller for Lqr {
         let sigma = k_sigma
             .try_inverse()
             .map_or(Vector2::zeros(), |inv| inv * need);
-        out[0] = sigma.x;
-        out[1] = sigma.y;
-        out[2..2 + velocity_filter::STATES].fill(0.0);
+        ErrorStates::rest(sigma, out);
     }
     fn hold_height(&mut self, z0: f64) -> Result<(), ControlError> {
         self.design_point.y = z0;

@@ -12,6 +12,7 @@
 
 pub mod computed_torque;
 pub mod distribution;
+pub mod error_states;
 pub mod lqr;
 pub mod pid;
 pub mod pid_xz;
@@ -269,24 +270,5 @@ impl Controller for AnyController {
     }
     fn gains(&self) -> Vec<(&'static str, Vec<f64>)> {
         each!(self, c => c.gains())
-    }
-}
-
-/// The trapezoidal update of integrator states σ' = e [m s] from `start` with the errors at
-/// the step's start and end, held while the command is saturated (conditional integration).
-pub(crate) fn integrate_trapezoidal(
-    start: &[f64],
-    e_start: [f64; 2],
-    e_end: [f64; 2],
-    h: f64,
-    saturated: bool,
-    out: &mut [f64],
-) {
-    for k in 0..2 {
-        out[k] = if saturated {
-            start[k]
-        } else {
-            start[k] + 0.5 * h * (e_start[k] + e_end[k])
-        };
     }
 }
