@@ -227,18 +227,14 @@ fn statics_sweep_outside_the_workspace_is_an_error() {
     );
 }
 
-/// `control` runs every controller on every model (a short record, for time) and writes the
-/// leaderboard: one CSV row per pair, the paper PID's path error in millimetres and the
-/// feedforward controllers' at round-off on the elastic model, the tables and figures in
-/// control.md.
-#[test]
-fn control_writes_the_leaderboard() {
-    let dir = TempDir::new("control");
+/// Runs `command --scenario short.toml --out DIR/out` with a record of `t_final` seconds and
+/// expects success; returns the output directory.
+fn run_short(dir: &TempDir, command: &str, t_final: f64) -> std::path::PathBuf {
     let scenario = dir.join("short.toml");
-    std::fs::write(&scenario, "[simulation]\nt_final = 1.5\n").unwrap();
+    std::fs::write(&scenario, format!("[simulation]\nt_final = {t_final}\n")).unwrap();
     let out = dir.join("out");
     let status = xtask()
-        .args(["control", "--scenario"])
+        .args([command, "--scenario"])
         .arg(&scenario)
         .arg("--out")
         .arg(&out)
@@ -249,6 +245,17 @@ fn control_writes_the_leaderboard() {
         "{}",
         String::from_utf8_lossy(&status.stderr)
     );
+    out
+}
+
+/// `control` runs every controller on every model (a short record, for time) and writes the
+/// leaderboard: one CSV row per pair, the paper PID's path error in millimetres and the
+/// feedforward controllers' at round-off on the elastic model, the tables and figures in
+/// control.md.
+#[test]
+fn control_writes_the_leaderboard() {
+    let dir = TempDir::new("control");
+    let out = run_short(&dir, "control", 1.5);
     let csv = std::fs::read_to_string(out.join("control.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv
         .lines()
@@ -321,21 +328,7 @@ fn modes_takes_the_controller() {
 #[test]
 fn shaping_writes_the_study() {
     let dir = TempDir::new("shaping");
-    let scenario = dir.join("short.toml");
-    std::fs::write(&scenario, "[simulation]\nt_final = 1.6\n").unwrap();
-    let out = dir.join("out");
-    let status = xtask()
-        .args(["shaping", "--scenario"])
-        .arg(&scenario)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        status.status.success(),
-        "{}",
-        String::from_utf8_lossy(&status.stderr)
-    );
+    let out = run_short(&dir, "shaping", 1.6);
     let csv = std::fs::read_to_string(out.join("shaping.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv
         .lines()
