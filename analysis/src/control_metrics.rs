@@ -83,12 +83,16 @@ impl ControlMetrics {
         let half = 0.5 * context.sample_period;
         let transition = t.partition_point(|&v| v < context.move_start - half)
             ..t.partition_point(|&v| v <= context.move_end + TRANSITION_TAIL + half);
+        // Maxima over the window; NaN where the record does not reach it.
         let (mut path, mut ex, mut ez) = (f64::NAN, f64::NAN, f64::NAN);
+        if !transition.is_empty() {
+            (path, ex, ez) = (0.0, 0.0, 0.0);
+        }
         for i in transition {
             let (e_x, e_z) = (err[i], z[i] - z0);
-            path = e_x.hypot(e_z).max(if path.is_nan() { 0.0 } else { path });
-            ex = e_x.abs().max(if ex.is_nan() { 0.0 } else { ex });
-            ez = e_z.abs().max(if ez.is_nan() { 0.0 } else { ez });
+            path = path.max(e_x.hypot(e_z));
+            ex = ex.max(e_x.abs());
+            ez = ez.max(e_z.abs());
         }
         let t_end = t.last().copied().unwrap_or(0.0);
         let last = t.partition_point(|&v| v < t_end - Z_MEAN_WINDOW - half);

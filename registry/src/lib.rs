@@ -52,8 +52,8 @@ pub use kind::ModelKind;
 pub use provenance::{Provenance, project_revision, revision};
 pub use study::{
     Assessed, EndAnalysis, Error, analyse, assess, assess_observed, damping_sweep, end_analysis,
-    end_state, eq15_at_end, growth_resolution, linearise, metrics, mode_as_integrated,
-    resolve_shaper, simulate, simulate_observed,
+    end_state, eq15_at_end, growth_resolution, least_damped_vertical_mode, linearise, metrics,
+    mode_as_integrated, resolve_shaper, simulate, simulate_observed,
 };
 
 /// The crates this one composes, for their types.

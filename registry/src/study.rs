@@ -12,7 +12,7 @@ use cdpr_analysis::linearise::{self, EndState, Linearised};
 use cdpr_analysis::metrics::Metrics;
 use cdpr_analysis::modes::{Analysis, ClassifiedMode, Loop, ModeKind};
 use cdpr_core::closed_loop::ClosedLoop;
-use cdpr_core::controller::{Controller, TensionLimits};
+use cdpr_core::controller::TensionLimits;
 use cdpr_core::model::{CableModel, ModelError};
 use cdpr_core::runner::{Observer, Run, RunFailure, RunOptions, simulate_observed as simulate_run};
 use cdpr_core::scenario::{Designed, IntegratorKind, ModesChoice, Scenario, ScenarioError};
@@ -219,23 +219,19 @@ pub fn metrics(scenario: &Scenario, run: &Run) -> Metrics {
         shaper_damping: design(t.shaper_damping),
     };
     let mut metrics = Metrics::from_run(run, &step5, scenario.simulation.sample_period, &context);
-    metrics.control.controller_gains = controller_gains(scenario);
+    metrics.control.controller_gains = run
+        .controller_gains
+        .iter()
+        .map(|(name, values)| ((*name).to_owned(), values.clone()))
+        .collect();
     metrics
 }
 
-/// The scenario with its shaper's "auto" design values replaced by the least-damped vertical
-/// mode of the model's closed loop at x2 (natural frequency |λ| and damping ratio −σ/|λ|, a
-/// growing mode's taken as 0), from the modal analysis of the unshaped loop; unchanged when
-/// nothing is "auto".
-pub fn resolve_shaper(scenario: &Scenario) -> Result<Scenario, Error> {
-    let t = &scenario.trajectory;
-    let auto = t.shaper_frequency.value().is_none() || t.shaper_damping.value().is_none();
-    if t.shaper == ShaperKind::None || !auto {
-        return Ok(scenario.clone());
-    }
-    let mut unshaped = scenario.clone();
-    unshaped.trajectory.shaper = ShaperKind::None;
-    let analysis = analyse(&unshaped, t.x2, Loop::Closed)?;
+/// The least-damped oscillatory vertical mode of the scenario's closed loop at effector position
+/// x [m]: its natural frequency |λ| [rad/s] and damping ratio −σ/|λ| (a growing mode's taken as
+/// 0), what a shaper is designed for.
+pub fn least_damped_vertical_mode(scenario: &Scenario, x: f64) -> Result<(f64, f64), Error> {
+    let analysis = analyse(scenario, x, Loop::Closed)?;
     let mode = analysis
         .modes
         .iter()
@@ -245,33 +241,34 @@ pub fn resolve_shaper(scenario: &Scenario) -> Result<Scenario, Error> {
             zeta(a).total_cmp(&zeta(b))
         })
         .ok_or(AnalysisError::NoMode)?;
+    Ok((
+        mode.mode.growth.hypot(mode.mode.omega),
+        mode.mode.damping_ratio().max(0.0),
+    ))
+}
+
+/// The scenario with its shaper's "auto" design values replaced by the least-damped vertical
+/// mode of the model's closed loop at x2 ([`least_damped_vertical_mode`]), from the modal
+/// analysis of the unshaped loop; unchanged when nothing is "auto".
+pub fn resolve_shaper(scenario: &Scenario) -> Result<Scenario, Error> {
+    let t = &scenario.trajectory;
+    let auto = t.shaper_frequency.value().is_none() || t.shaper_damping.value().is_none();
+    if t.shaper == ShaperKind::None || !auto {
+        return Ok(scenario.clone());
+    }
+    let mut unshaped = scenario.clone();
+    unshaped.trajectory.shaper = ShaperKind::None;
+    let (omega, zeta) = least_damped_vertical_mode(&unshaped, t.x2)?;
     let mut resolved = scenario.clone();
     let r = &mut resolved.trajectory;
     if r.shaper_frequency.value().is_none() {
-        r.shaper_frequency = Designed::Value(mode.mode.growth.hypot(mode.mode.omega));
+        r.shaper_frequency = Designed::Value(omega);
     }
     if r.shaper_damping.value().is_none() {
-        r.shaper_damping = Designed::Value(mode.mode.damping_ratio().max(0.0));
+        r.shaper_damping = Designed::Value(zeta);
     }
     resolved.validate()?;
     Ok(resolved)
-}
-
-/// The gains the scenario's controller designs for itself (the LQR's K at the start
-/// equilibrium's height), by name; empty where there are none or the design failed.
-pub fn controller_gains(scenario: &Scenario) -> std::collections::BTreeMap<String, Vec<f64>> {
-    let Ok(model) = build(scenario) else {
-        return Default::default();
-    };
-    let mut sys = ClosedLoop::new(model, scenario);
-    if sys.initial_state().is_err() {
-        return Default::default();
-    }
-    sys.controller
-        .gains()
-        .into_iter()
-        .map(|(name, values)| (name.to_owned(), values))
-        .collect()
 }
 
 /// The static equilibrium at x2 and the closed-loop mode nearest eq. 15 there (the effector's

@@ -8,10 +8,9 @@
 
 use crate::figures::{self, Figure, Line, Marker, Panel};
 use crate::output::write_atomic;
-use anyhow::{Result, anyhow};
+use anyhow::Result;
 use cdpr_bench::ModelKind;
-use cdpr_bench::analysis::modes::{Loop, ModeKind};
-use cdpr_bench::core::scenario::{Designed, IntegratorKind, Scenario};
+use cdpr_bench::core::scenario::{Designed, Scenario};
 use cdpr_bench::core::shaper::{Impulses, ShaperKind};
 use plotters::style::RGBColor;
 use std::fmt::Write as _;
@@ -46,38 +45,9 @@ pub struct Point {
 fn base_for(base: &Scenario, model: ModelKind) -> Result<Scenario> {
     let mut s = cdpr_bench::with_model_kind(base, model)?;
     s.simulation.sample_period = SAMPLE_PERIOD;
-    s.simulation.integrator = if model == ModelKind::Elastic {
-        IntegratorKind::Dopri5
-    } else {
-        IntegratorKind::Implicit
-    };
+    s.simulation.integrator = crate::control::fast_integrator(model);
     s.analysis.modes = cdpr_bench::core::scenario::ModesChoice::Off;
     Ok(s)
-}
-
-/// The auto design (least-damped vertical mode at x): natural frequency and damping ratio.
-fn vertical_mode(s: &Scenario, x: f64) -> Result<(f64, f64)> {
-    let analysis = cdpr_bench::analyse(s, x, Loop::Closed)?;
-    analysis
-        .modes
-        .iter()
-        .filter(|m| m.kind == ModeKind::Vertical && m.mode.omega > 0.0)
-        .min_by(|a, b| {
-            let z = |m: &cdpr_bench::analysis::modes::ClassifiedMode| m.mode.damping_ratio().abs();
-            z(a).total_cmp(&z(b))
-        })
-        .map(|m| {
-            (
-                m.mode.growth.hypot(m.mode.omega),
-                m.mode.damping_ratio().max(0.0),
-            )
-        })
-        .ok_or_else(|| {
-            anyhow!(
-                "{}: no vertical mode at x = {x}",
-                s.model.0.get("kind").map_or("?".into(), |k| k.to_string())
-            )
-        })
 }
 
 /// Runs `s` with `shaper` designed at (ω, ζ): z p2p over [1, 5] s, move end, path error.
@@ -110,7 +80,7 @@ pub fn compute(base: &Scenario) -> Result<Study> {
     let mut jobs = Vec::new();
     for model in ModelKind::ALL {
         let s = base_for(base, model)?;
-        let (omega, zeta) = vertical_mode(&s, s.trajectory.x2)?;
+        let (omega, zeta) = cdpr_bench::least_damped_vertical_mode(&s, s.trajectory.x2)?;
         let (p2p, _, _) = run(&s, ShaperKind::None, omega, zeta)?;
         unshaped.push((model, p2p, omega, zeta));
         for shaper in ShaperKind::ALL.into_iter().skip(1) {
@@ -152,8 +122,8 @@ pub fn compute(base: &Scenario) -> Result<Study> {
 /// from x1 = 0.5 m (the symmetric point) and from 0.55 m, where a linear loop would leave V.
 fn limits(base: &Scenario) -> Result<String> {
     let s = base_for(base, ModelKind::Elastic)?;
-    let (w1, _) = vertical_mode(&s, s.trajectory.x1)?;
-    let (w2, z2) = vertical_mode(&s, s.trajectory.x2)?;
+    let (w1, _) = cdpr_bench::least_damped_vertical_mode(&s, s.trajectory.x1)?;
+    let (w2, z2) = cdpr_bench::least_damped_vertical_mode(&s, s.trajectory.x2)?;
     let (unshaped, _, _) = run(&s, ShaperKind::None, w2, z2)?;
     let mut md = format!(
         "The elastic model with the paper's PID. The vertical mode sweeps {w1:.4} → {w2:.4} rad/s from x1 \
@@ -181,7 +151,7 @@ fn limits(base: &Scenario) -> Result<String> {
             let mut m = s.clone();
             m.trajectory.x1 = x1;
             m.trajectory.x2 = x1 + dx;
-            let (w, z) = vertical_mode(&m, m.trajectory.x2)?;
+            let (w, z) = cdpr_bench::least_damped_vertical_mode(&m, m.trajectory.x2)?;
             let (base_p2p, _, _) = run(&m, ShaperKind::None, w, z)?;
             let (p2p, _, _) = run(&m, ShaperKind::Zv, w, z)?;
             let _ = write!(row, " {:.3} % |", 100.0 * p2p / base_p2p);

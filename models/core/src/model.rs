@@ -46,7 +46,7 @@ pub fn check_effector_x(effector_x: f64, anchor_distance: f64) -> Result<(), Mod
 }
 
 /// Position and velocity of the effector (the point mass C of the paper) [m, m/s].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Effector {
     pub position: Vector2<f64>,
     pub velocity: Vector2<f64>,

@@ -4,6 +4,7 @@
 
 use crate::channel::Channel;
 use crate::closed_loop::ClosedLoop;
+use crate::controller::Controller;
 use crate::model::{CableModel, Equilibrium, ModelError, ModelEvent};
 use crate::scenario::{ImplicitMethod, IntegratorKind, Scenario};
 use crate::series::TimeSeries;
@@ -74,6 +75,9 @@ pub struct Run {
     pub events: Vec<ModelEvent>,
     /// Wall-clock time of the integration [s] (the only non-reproducible number of a run).
     pub wall_s: f64,
+    /// The gains the controller designed for this run (the LQR's K at the start's height), by
+    /// name, row-major.
+    pub controller_gains: Vec<(&'static str, Vec<f64>)>,
 }
 
 /// A summary, not the samples (a failed `unwrap` would otherwise print megabytes).
@@ -366,6 +370,7 @@ fn integrate_and_sample<M: CableModel>(
         t_reached,
         events,
         wall_s: start.elapsed().as_secs_f64(),
+        controller_gains: sys.controller.gains(),
     };
     match outcome {
         Ok(()) => Ok(run),

@@ -10,11 +10,11 @@ use crate::model::{CableModel, Effector};
 use cdpr_numerics::{MatrixCost, SecondOrderSystem};
 
 /// What an implicit step needs from its start (t_n, y_n) besides the integrator's own state.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(super) struct StepStart {
     h: f64,
     reference: Reference,
-    effector: Option<Effector>,
+    effector: Effector,
     states: [f64; MAX_CONTROLLER_STATES],
     saturated: bool,
     /// Reel power Σ T_i v_reel,i [W] and model dissipation [W] at t_n.
@@ -23,22 +23,6 @@ pub(super) struct StepStart {
     /// W and D at t_n [J].
     work: f64,
     dissipated: f64,
-}
-
-impl StepStart {
-    pub(super) fn new(_controller_states: usize) -> Self {
-        Self {
-            h: 0.0,
-            reference: Reference::default(),
-            effector: None,
-            states: [0.0; MAX_CONTROLLER_STATES],
-            saturated: false,
-            power: 0.0,
-            dissipation: 0.0,
-            work: 0.0,
-            dissipated: 0.0,
-        }
-    }
 }
 
 impl<M: CableModel> ClosedLoop<M> {
@@ -55,7 +39,7 @@ impl<M: CableModel> ClosedLoop<M> {
         let reference = self.reference(t);
         let start = controller::StepStart {
             reference: s.reference,
-            effector: s.effector.unwrap_or(*effector),
+            effector: s.effector,
             states: &s.states[..c],
             saturated: s.saturated,
         };
@@ -64,17 +48,14 @@ impl<M: CableModel> ClosedLoop<M> {
         self.command_with(t, &reference, effector, &states[..c])
     }
 
-    /// The effector columns (x, then z where the controller measures it) of the iteration
-    /// matrix that close the loop through the tension rows.
-    fn effector_columns(&self) -> Vec<usize> {
+    /// The effector columns of the iteration matrix that close the loop through the tension
+    /// rows: x, then z where the controller measures it (the first `count` of the array).
+    fn effector_columns(&self) -> ([usize; 2], usize) {
         let Some(form) = self.model.second_order() else {
-            return Vec::new();
+            return ([0; 2], 0);
         };
-        let mut columns = vec![form.effector_x()];
-        if self.controller.measures().z {
-            columns.push(form.effector_z());
-        }
-        columns
+        let count = if self.controller.measures().z { 2 } else { 1 };
+        ([form.effector_x(), form.effector_z()], count)
     }
 
     /// dT/dq_k + (c_v/c_q) dT/dq'_k of the step-end tensions for the effector coordinate k
@@ -118,7 +99,8 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         };
         let mut pattern = form.iteration_pattern();
         let rows = form.tension_rows();
-        for column in self.effector_columns() {
+        let (columns, count) = self.effector_columns();
+        for &column in &columns[..count] {
             pattern.extend(rows.iter().map(|&row| (row, column)));
         }
         pattern
@@ -133,7 +115,8 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         };
         let mut coupled = form.coupled_unknowns();
         if !form.tension_rows().is_empty() {
-            coupled.extend(self.effector_columns());
+            let (columns, count) = self.effector_columns();
+            coupled.extend_from_slice(&columns[..count]);
         }
         coupled
     }
@@ -141,16 +124,16 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
     fn begin_step(&mut self, t: f64, y: &[f64], h: f64) {
         let n = self.model_len();
         let c = self.controller_len();
-        let cmd = self.command(t, y);
         let model_state = &y[..n];
-        let reel = self.model.reel_speeds(model_state);
         let effector = self.model.effector(model_state);
         let reference = self.reference(t);
+        let cmd = self.command_with(t, &reference, &effector, &y[n..n + c]);
+        let reel = self.model.reel_speeds(model_state);
         let dissipation = self.model.dissipation(model_state);
         let s = &mut self.step_start;
         s.h = h;
         s.reference = reference;
-        s.effector = Some(effector);
+        s.effector = effector;
         s.states[..c].copy_from_slice(&y[n..n + c]);
         s.saturated = cmd.saturated;
         s.power = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
@@ -182,7 +165,7 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         let effector = self.model.effector(&y[..n]);
         let mut states = [0.0; MAX_CONTROLLER_STATES];
         let tensions = self.step_end_command(t, &effector, &mut states).tensions;
-        let columns = self.effector_columns().len();
+        let columns = self.effector_columns().1;
         let mut slopes = [[0.0; 2]; 2];
         for (k, slope) in slopes.iter_mut().enumerate().take(columns) {
             *slope = self.tension_slope(t, &effector, tensions, k, c_v, c_q);
@@ -227,7 +210,7 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         let n = self.model_len();
         let effector = self.model.effector(&y[..n]);
         let reference = self.reference(t);
-        let cmd = self.command(t, y);
+        let cmd = self.command_with(t, &reference, &effector, &y[n..n + self.controller_len()]);
         self.controller_and_audit_rates(y, (&reference, &effector), &cmd, out);
     }
 

@@ -94,7 +94,7 @@ impl<M: CableModel> ClosedLoop<M> {
             z_hold: None,
             feedforward,
             rest_tensions: [0.0; 2],
-            step_start: implicit::StepStart::new(c),
+            step_start: implicit::StepStart::default(),
             residual_scratch: Default::default(),
         }
     }

@@ -41,6 +41,17 @@ pub struct PidState {
     pub filter: f64,
 }
 
+impl PidState {
+    /// The states (w, f) at the start of `states`, a controller's state slice.
+    #[inline]
+    pub fn of(states: &[f64]) -> Self {
+        Self {
+            integral: states[0],
+            filter: states[1],
+        }
+    }
+}
+
 impl Pid {
     /// Force F = P e + I w + D N_f (e − f) [N] for the tracking error e = x_ref − x [m].
     #[inline]
@@ -100,13 +111,6 @@ impl From<&scenario::Controller> for PaperPid {
     }
 }
 
-fn pid_state(states: &[f64]) -> PidState {
-    PidState {
-        integral: states[0],
-        filter: states[1],
-    }
-}
-
 impl Controller for PaperPid {
     fn kind(&self) -> ControllerKind {
         ControllerKind::Pid
@@ -123,7 +127,7 @@ impl Controller for PaperPid {
     #[inline]
     fn output(&self, reference: &Reference, effector: &Effector, states: &[f64]) -> Output {
         let error = reference.position.x - effector.position.x;
-        let force = self.pid.force(error, pid_state(states));
+        let force = self.pid.force(error, PidState::of(states));
         Output {
             force,
             tensions: split_tensions(self.tension_sum, force),
@@ -139,7 +143,7 @@ impl Controller for PaperPid {
         rate: &mut [f64],
     ) {
         let error = reference.position.x - effector.position.x;
-        let r = self.pid.state_rate(error, pid_state(states));
+        let r = self.pid.state_rate(error, PidState::of(states));
         rate[0] = r.integral;
         rate[1] = r.filter;
     }
@@ -155,7 +159,7 @@ impl Controller for PaperPid {
         let e_end = reference.position.x - effector.position.x;
         let s = self
             .pid
-            .trapezoidal_step(pid_state(start.states), e_start, e_end, h);
+            .trapezoidal_step(PidState::of(start.states), e_start, e_end, h);
         out[0] = s.integral;
         out[1] = s.filter;
     }

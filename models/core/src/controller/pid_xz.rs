@@ -41,11 +41,9 @@ impl PidXz {
     }
 }
 
+/// Loop k's (x: 0, z: 1) PID states in `states`.
 fn state(states: &[f64], k: usize) -> PidState {
-    PidState {
-        integral: states[2 * k],
-        filter: states[2 * k + 1],
-    }
+    PidState::of(&states[2 * k..])
 }
 
 impl Controller for PidXz {
