@@ -19,6 +19,7 @@ mod report;
 mod shaping;
 mod simulate;
 mod statics_sweep;
+mod sweep;
 mod work_precision;
 
 use cdpr_bench::ModelKind;
@@ -132,6 +133,27 @@ enum Command {
         #[arg(long, default_value_t = 250)]
         tension_steps: usize,
     },
+    /// A parameter study: every point of a grid file (a base scenario and axes over dotted
+    /// scenario keys) run metrics-only on all cores → DIR/results.jsonl and DIR/results.csv.
+    /// An interrupted sweep resumes; `--shard I/N` runs points i ≡ I (mod N) (a Slurm array
+    /// task); `--merge DIR...` combines the shards' results into `--out`.
+    Sweep {
+        /// Grid file (TOML: [scenario], [axes], [sweep]).
+        #[arg(long, required_unless_present = "merge")]
+        grid: Option<PathBuf>,
+        /// Output directory (created if missing; a sweep's own results there are resumed).
+        #[arg(long)]
+        out: PathBuf,
+        /// Worker threads; default: every core.
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Run only shard I of N (points i with i mod N = I).
+        #[arg(long)]
+        shard: Option<String>,
+        /// Merge these shards' result directories (or results.jsonl files) into --out.
+        #[arg(long, num_args = 1.., conflicts_with_all = ["grid", "shard", "jobs"])]
+        merge: Vec<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -153,6 +175,16 @@ fn main() -> ExitCode {
         } => modes::run(scenario.as_deref(), controller, at, &out),
         Command::Control { scenario, out } => control::run(scenario.as_deref(), &out),
         Command::Shaping { scenario, out } => shaping::run_study(scenario.as_deref(), &out),
+        Command::Sweep {
+            grid,
+            out,
+            jobs,
+            shard,
+            merge,
+        } => match grid {
+            Some(grid) => sweep::run(&grid, &out, jobs, shard.as_deref()),
+            None => sweep::merge(&merge, &out),
+        },
         Command::StaticsSweep {
             scenario,
             model,
