@@ -33,6 +33,15 @@ pub enum Window {
     Hann,
 }
 
+thread_local! {
+    /// One planner per thread keeps its plans: a sweep's runs repeat the same lengths, and a
+    /// plan (its twiddles, Bluestein's for lengths with large prime factors) costs more than the
+    /// transform. The planner picks the same algorithm for a length every time, so spectra are
+    /// the same bits as with a fresh planner.
+    static PLANNER: std::cell::RefCell<RealFftPlanner<f64>> =
+        std::cell::RefCell::new(RealFftPlanner::new());
+}
+
 impl Spectrum {
     /// Spectrum of `signal` sampled every `dt` [s], mean removed, windowed and zero-padded to
     /// `pad`·n points.
@@ -46,8 +55,7 @@ impl Spectrum {
             };
         }
         let mean = signal.iter().sum::<f64>() / n as f64;
-        let mut planner = RealFftPlanner::<f64>::new();
-        let fft = planner.plan_fft_forward(len);
+        let fft = PLANNER.with(|p| p.borrow_mut().plan_fft_forward(len));
         let mut input = fft.make_input_vec();
         let mut output = fft.make_output_vec();
         let mut weight_sum = 0.0;

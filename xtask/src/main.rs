@@ -12,6 +12,7 @@
 
 mod control;
 mod figures;
+mod heatmap;
 mod modes;
 mod output;
 mod pool;
@@ -20,6 +21,7 @@ mod shaping;
 mod simulate;
 mod statics_sweep;
 mod sweep;
+mod sweep_study;
 mod work_precision;
 
 use cdpr_bench::ModelKind;

@@ -137,6 +137,9 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     // Every input shaper on every model with the paper's PID (~40 s on two cores).
     let shaping = crate::shaping::compute(&base)?;
     let shaping_figures = shaping.write(out)?;
+    // The mass × move-time parameter study on every model (150 points, ~15 s on two cores).
+    let sweeps = crate::sweep_study::compute(&base, out)?;
+    let sweep_figures = sweeps.write(out)?;
     write_json(
         &out.join("metrics.json"),
         &ReportFile {
@@ -156,9 +159,10 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     )?;
     let control_section = format!(
         "{}\n## Input shaping with the paper's PID\n\nBeyond the paper (`cargo xtask shaping`; shaping.csv has \
-         every run).\n\n{}",
+         every run).\n\n{}\n{}",
         control.section(&control_figures),
-        shaping.section(&shaping_figures)
+        shaping.section(&shaping_figures),
+        sweeps.section(&sweep_figures)
     );
     write_markdown(
         &base,

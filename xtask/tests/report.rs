@@ -7,7 +7,9 @@ use common::TempDir;
 use std::path::Path;
 use std::process::Command;
 
-const FIGURES: [&str; 5] = [
+const FIGURES: [&str; 7] = [
+    "sweep_z_p2p",
+    "sweep_err_transition",
     "fig5_position",
     "fig6_error",
     "fig7_spectrum",

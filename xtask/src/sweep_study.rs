@@ -1,0 +1,243 @@
+//! The report's first parameter study (`examples/sweeps/mass_time_*.toml`): the paper's move on
+//! each cable model with the paper's PID and the LQR, over effector mass 0.25–4 kg × move time
+//! 0.1–0.5 s. Runs the grids with `cdpr-sweep` into `DIR/sweeps/`, draws heat maps of the
+//! vertical residual vibration and the transition error, and writes the REPORT.md section.
+
+use crate::heatmap::{HeatMap, HeatPanel};
+use anyhow::{Context, Result};
+use cdpr_bench::ModelKind;
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_sweep::{Grid, Options, Record, Shard};
+use std::path::{Path, PathBuf};
+
+/// The controllers of the study's grids, in their `controller.kind` axis order.
+const CONTROLLERS: [&str; 2] = ["pid", "lqr"];
+const MASS: &str = "robot.effector_mass";
+const MOVE: &str = "trajectory.t2";
+
+/// The metrics drawn: key, figure name, title.
+const METRICS: [(&str, &str, &str); 2] = [
+    (
+        "z_p2p",
+        "sweep_z_p2p",
+        "vertical residual vibration: z peak-to-peak over [t2 + 0.8 s, 5 s] [m]",
+    ),
+    (
+        "err_max_transition",
+        "sweep_err_transition",
+        "transition error: max |x_ref − x| during the move [m]",
+    ),
+];
+
+/// One model's grid and its records.
+pub struct ModelSweep {
+    pub kind: ModelKind,
+    pub grid: Grid,
+    pub records: Vec<Record>,
+    pub wall_s: f64,
+}
+
+pub struct SweepStudy {
+    pub sweeps: Vec<ModelSweep>,
+}
+
+fn grid_path(kind: ModelKind) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples/sweeps")
+        .join(format!("mass_time_{}.toml", kind.name()))
+}
+
+/// Runs the three grids afresh into `out/sweeps/mass_time_<model>/` on every core, for the
+/// report's `simulation.t_final` (5 s for the paper; shorter for a quick report).
+pub fn compute(base: &Scenario, out: &Path) -> Result<SweepStudy> {
+    let mut sweeps = Vec::new();
+    for kind in ModelKind::ALL {
+        let mut grid = Grid::from_file(&grid_path(kind))?;
+        if let toml::Value::Table(simulation) = grid
+            .base
+            .entry("simulation")
+            .or_insert_with(|| toml::Value::Table(Default::default()))
+        {
+            simulation.insert("t_final".into(), base.simulation.t_final.into());
+        }
+        let dir = out
+            .join("sweeps")
+            .join(format!("mass_time_{}", kind.name()));
+        // A report is made afresh: an earlier report's records are not resumed.
+        for file in [cdpr_sweep::store::RESULTS, cdpr_sweep::store::RESULTS_CSV] {
+            let _ = std::fs::remove_file(dir.join(file));
+        }
+        let start = std::time::Instant::now();
+        cdpr_sweep::run(
+            &grid,
+            &dir,
+            Options {
+                jobs: cdpr_sweep::all_cores(),
+                shard: Shard::ALL,
+                stop: None,
+            },
+            &mut |_, _| {},
+        )
+        .with_context(|| format!("the {} mass × move-time sweep", kind.name()))?;
+        let wall_s = start.elapsed().as_secs_f64();
+        let (_, records) = cdpr_sweep::store::read(&dir.join(cdpr_sweep::store::RESULTS))?;
+        sweeps.push(ModelSweep {
+            kind,
+            grid,
+            records,
+            wall_s,
+        });
+    }
+    Ok(SweepStudy { sweeps })
+}
+
+/// The values of an axis, in order.
+fn axis(grid: &Grid, key: &str) -> Vec<f64> {
+    grid.axes
+        .iter()
+        .find(|a| a.key == key)
+        .map(|a| a.values.iter().filter_map(|v| v.as_float()).collect())
+        .unwrap_or_default()
+}
+
+fn param(r: &Record, key: &str) -> Option<f64> {
+    r.params.get(key).and_then(|v| v.as_f64())
+}
+
+impl ModelSweep {
+    /// values[mass index][move index] of `metric` for `controller` (None: failed or null).
+    fn table(&self, controller: &str, metric: &str) -> Vec<Vec<Option<f64>>> {
+        let (masses, moves) = (axis(&self.grid, MASS), axis(&self.grid, MOVE));
+        masses
+            .iter()
+            .map(|&m| {
+                moves
+                    .iter()
+                    .map(|&t| {
+                        self.records
+                            .iter()
+                            .find(|r| {
+                                r.params.get("controller.kind").and_then(|v| v.as_str())
+                                    == Some(controller)
+                                    && param(r, MASS) == Some(m)
+                                    && param(r, MOVE) == Some(t)
+                            })
+                            .filter(|r| r.status == "complete")
+                            .and_then(|r| r.metrics.get(metric).and_then(|v| v.as_f64()))
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+}
+
+impl SweepStudy {
+    /// Writes the heat maps; returns their names.
+    pub fn write(&self, out: &Path) -> Result<Vec<&'static str>> {
+        let first = &self.sweeps[0].grid;
+        let x_labels: Vec<String> = axis(first, MOVE)
+            .iter()
+            .map(|t| format!("{t:.1}"))
+            .collect();
+        let y_labels: Vec<String> = axis(first, MASS)
+            .iter()
+            .map(|m| format!("{m:.2}"))
+            .collect();
+        let mut names = Vec::new();
+        for (metric, name, title) in METRICS {
+            let mut panels = Vec::new();
+            for c in CONTROLLERS {
+                for s in &self.sweeps {
+                    panels.push(HeatPanel {
+                        title: format!("{} · {c}", s.kind.name()),
+                        x_labels: x_labels.clone(),
+                        y_labels: y_labels.clone(),
+                        values: s.table(c, metric),
+                    });
+                }
+            }
+            let map = HeatMap {
+                title: title.into(),
+                x_name: "move end t2 [s]".into(),
+                y_name: "effector mass [kg]".into(),
+                value_name: "log10".into(),
+                rows: CONTROLLERS.len(),
+                cols: self.sweeps.len(),
+                panels,
+            };
+            crate::figures::render_drawing(&map, name, out)?;
+            names.push(name);
+        }
+        Ok(names)
+    }
+
+    /// The REPORT.md section.
+    pub fn section(&self, figures: &[&str]) -> String {
+        let mut s = String::from(
+            "## Parameter study: effector mass × move time\n\n\
+             Beyond the paper (`cargo xtask sweep --grid examples/sweeps/mass_time_<model>.toml`; \
+             records in `sweeps/`). The paper's move x 0.5 → 0.6 m with effector mass \
+             0.25–4 kg (log) × move end t2 0.1–0.5 s, the paper's PID and the LQR, on each cable \
+             model; samples every 0.1 ms. A cross marks a point that failed (a cable went \
+             slack).\n\n",
+        );
+        let points: usize = self.sweeps.iter().map(|s| s.records.len()).sum();
+        let wall: f64 = self.sweeps.iter().map(|s| s.wall_s).sum();
+        s.push_str(&format!(
+            "{points} points in {wall:.1} s on {} cores.\n\n",
+            cdpr_sweep::all_cores()
+        ));
+        for f in figures {
+            s.push_str(&format!("![{f}]({f}.svg)\n\n"));
+        }
+        s.push_str(
+            "| model | controller | points | failed | z p2p range [µm] | transition error range [mm] |\n\
+             |---|---|---|---|---|---|\n",
+        );
+        for sweep in &self.sweeps {
+            for c in CONTROLLERS {
+                let range = |metric: &str, scale: f64| {
+                    let v: Vec<f64> = sweep
+                        .table(c, metric)
+                        .into_iter()
+                        .flatten()
+                        .flatten()
+                        .collect();
+                    if v.is_empty() {
+                        return "–".to_string();
+                    }
+                    let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+                    let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    format!("{} – {}", significant(lo * scale), significant(hi * scale))
+                };
+                let ours: Vec<&Record> = sweep
+                    .records
+                    .iter()
+                    .filter(|r| r.params.get("controller.kind").and_then(|v| v.as_str()) == Some(c))
+                    .collect();
+                let failed = ours.iter().filter(|r| r.status != "complete").count();
+                s.push_str(&format!(
+                    "| {} | {c} | {} | {failed} | {} | {} |\n",
+                    sweep.kind.name(),
+                    ours.len(),
+                    range("z_p2p", 1e6),
+                    range("err_max_transition", 1e3),
+                ));
+            }
+        }
+        s.push('\n');
+        s
+    }
+}
+
+/// Three significant digits, plain between 0.01 and 10⁵, else in exponent form.
+fn significant(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if !(0.01..1e5).contains(&v.abs()) {
+        format!("{v:.2e}")
+    } else {
+        let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+        format!("{v:.digits$}")
+    }
+}
