@@ -105,9 +105,9 @@ proptest! {
     /// Over the effector's x and ΣT, the cable's EA, μ and length, the effector's mass and the
     /// element count: the FE model is second order, so halving the elements divides the distance
     /// between the catenaries' end and the model's effector by 3–5 (the error constant depends
-    /// on the sag, so the order is asserted; a defect that does not vanish with the mesh, such as
-    /// a cable 1 % too heavy, sends the ratio to 1), and at 2N the distance is below 1e-3 of the
-    /// effector's depth (measured ≤ 1e-4).
+    /// on the sag, so the order is asserted wherever the distance is above 1e-10 m; a defect
+    /// that does not vanish with the mesh, such as a cable 1 % too heavy, sends the ratio to 1),
+    /// and at 2N the distance is below 1e-5 of the effector's depth.
     #[test]
     fn fe_equilibria_are_irvine_catenaries(
         elements in 8i64..24,
@@ -121,8 +121,13 @@ proptest! {
         let c = Case { kind: ModelKind::Fe, elements, x, tension_sum, youngs, density, mass, length };
         let (coarse, depth, _) = mismatch(c);
         let (fine, _, _) = mismatch(Case { elements: 2 * elements, ..c });
-        let ratio = coarse / fine;
-        prop_assert!((3.0..=5.0).contains(&ratio), "{c:?}: distance {coarse:e} → {fine:e} m");
+        // A taut, light cable's discretisation error can fall to the Newton stop's position
+        // error, ~1e-7 N over EA/L ≈ 4e4 N/m, 2.4e-12 m (a case at 3.3e-12 → 1.3e-12 m): the order
+        // is asserted where the error stands 40× above that.
+        if coarse > 1e-10 {
+            let ratio = coarse / fine;
+            prop_assert!((3.0..=5.0).contains(&ratio), "{c:?}: distance {coarse:e} → {fine:e} m");
+        }
         prop_assert!(fine <= 1e-5 * depth, "{c:?}: distance {fine:e} m, depth {depth} m");
     }
 
