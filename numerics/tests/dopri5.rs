@@ -314,6 +314,27 @@ fn fifth_order_steps_and_fourth_order_dense_output_oscillator() {
     );
 }
 
+/// y' = cos(t) y: the right-hand side depends on t, so the stage times c_i h enter (an
+/// autonomous problem never sees them); y = e^{sin t} for y(0) = 1 (a fixed-step DOPRI5 written
+/// from the tableau shows orders 5.16, 5.10, 5.05 for h = 1/8 … 1/64; y' = t y was rejected as a
+/// check: its error constant nearly cancels, orders 4.68, 4.05, 4.68). A wrong stage time
+/// (c_5 = 8 for 8/9, t − c_4 h) leaves first order.
+struct Forced;
+
+impl OdeSystem for Forced {
+    fn dimension(&self) -> usize {
+        1
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        dy[0] = t.cos() * y[0];
+    }
+}
+
+#[test]
+fn fifth_order_steps_and_fourth_order_dense_output_time_dependent() {
+    assert_orders("y' = cos(t) y", || Forced, &[1.0], |t| vec![t.sin().exp()]);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Tolerance proportionality
 // ---------------------------------------------------------------------------------------------
