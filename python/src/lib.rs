@@ -105,10 +105,22 @@ fn simulate<'py>(
         })
         .map_err(error)?;
     let metrics = to_py(py, &Value::Object(map))?;
-    let series = PyDict::new(py);
+    // The samples are stored row by row: one pass over them fills every column (a pass per
+    // column would read the whole record once per channel).
     let run = &assessed.run.series;
-    for name in run.names() {
-        let column = run.column_named(name).unwrap_or_default();
+    let columns = py.detach(|| {
+        let mut columns: Vec<Vec<f64>> = (0..run.width())
+            .map(|_| Vec::with_capacity(run.len()))
+            .collect();
+        for i in 0..run.len() {
+            for (column, &v) in columns.iter_mut().zip(run.row(i)) {
+                column.push(v);
+            }
+        }
+        columns
+    });
+    let series = PyDict::new(py);
+    for (name, column) in run.names().iter().zip(columns) {
         series.set_item(name, column.into_pyarray(py))?;
     }
     Ok((metrics, series))
