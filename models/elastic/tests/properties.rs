@@ -184,3 +184,36 @@ fn reel_speeds_are_the_shortening_rates() {
         );
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Eq. 1 inverted: the unstrained lengths the model reports (`unstrained_lengths` and the
+    /// `l0_1`, `l0_2` channels) give back each tension by Hooke's law, T = EA (l − l0)/l0, with
+    /// l = |P − A_i| written here from the geometry. Relative tolerance 1e-12 · EA/T: the
+    /// subtraction l − l0 ≈ l T/EA turns the ~2e-16 rounding of l0 into ~2e-16 · EA/T of T
+    /// (up to 4e-11 here); a wrong eq. 1 errs by O(1).
+    #[test]
+    fn unstrained_lengths_invert_hookes_law(
+        x in 0.05f64..0.95,
+        z in -0.5f64..-0.001,
+        t1 in 1.0f64..500.0,
+        t2 in 1.0f64..500.0,
+    ) {
+        let m = model(1.0, 1.0, 9.81);
+        let ea = m.axial_stiffness;
+        let p = Vector2::new(x, z);
+        let lengths = [p.norm(), (p - Vector2::new(1.0, 0.0)).norm()];
+        let reported = m.unstrained_lengths(p, [t1, t2]);
+        let mut channels = vec![0.0; 4];
+        let y = [x, z, 0.0, 0.0];
+        m.channels(&y, [t1, t2], &mut channels);
+        for (k, t) in [t1, t2].into_iter().enumerate() {
+            prop_assert!((channels[k] / lengths[k] - 1.0).abs() < 1e-15, "l{}", k + 1);
+            for l0 in [reported[k], channels[2 + k]] {
+                let back = ea * (lengths[k] - l0) / l0;
+                prop_assert!((back / t - 1.0).abs() < 1e-12 * ea / t, "T{} = {t} N, back {back} N", k + 1);
+            }
+        }
+    }
+}
