@@ -281,3 +281,18 @@ fn bad_shaper_input_is_a_named_error() {
             .to_string();
     assert!(err.contains("shaper_frequency"), "{err}");
 }
+
+/// Each shaper's name (what `metrics.json` reports as `shaper`) is the word a scenario file uses
+/// for it: read back through `[trajectory] shaper`, every name gives its own kind.
+#[test]
+fn shaper_names_are_the_scenario_words() {
+    for kind in ShaperKind::ALL {
+        let text = format!(
+            "[trajectory]\nshaper = \"{}\"\nshaper_frequency = 20.0\n",
+            kind.name()
+        );
+        let scenario =
+            scenario_from_toml_str(&text).unwrap_or_else(|e| panic!("{}: {e}", kind.name()));
+        assert_eq!(scenario.trajectory.shaper, kind, "{}", kind.name());
+    }
+}
