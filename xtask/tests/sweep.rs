@@ -180,3 +180,59 @@ fn the_slurm_array_script_covers_the_grid() {
     assert!(o.status.success());
     assert_eq!(records_without_wall(&whole), records_without_wall(&merged));
 }
+
+/// A sweep killed (SIGKILL) at an arbitrary moment leaves a file whose every complete line is a
+/// record, and the same command resumes it to the one-machine sweep's records.
+#[test]
+fn a_killed_sweep_leaves_readable_records_and_resumes() {
+    let dir = TempDir::new("sweep-kill");
+    let grid = dir.join("grid.toml");
+    std::fs::write(
+        &grid,
+        "[scenario]\nsimulation = { t_final = 1.0 }\nanalysis = { modes = \"off\" }\n\
+         [axes]\n\"robot.effector_mass\" = { from = 0.5, to = 2.0, steps = 24 }\n",
+    )
+    .unwrap();
+    let out = dir.join("killed");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_xtask"))
+        .args(["sweep", "--jobs", "2", "--grid"])
+        .arg(&grid)
+        .arg("--out")
+        .arg(&out)
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait for the first records, then kill without warning.
+    let results = out.join("results.jsonl");
+    let start = std::time::Instant::now();
+    while std::fs::read_to_string(&results)
+        .map(|t| t.lines().count() < 3)
+        .unwrap_or(true)
+        && start.elapsed().as_secs() < 60
+    {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let text = std::fs::read_to_string(&results).unwrap();
+    let complete = &text[..text.rfind('\n').map_or(0, |i| i + 1)];
+    for line in complete.lines() {
+        serde_json::from_str::<serde_json::Value>(line).unwrap_or_else(|e| panic!("{e}: {line}"));
+    }
+    let o = sweep(&[
+        "--grid",
+        grid.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let fresh = dir.join("fresh");
+    let o = sweep(&[
+        "--grid",
+        grid.to_str().unwrap(),
+        "--out",
+        fresh.to_str().unwrap(),
+    ]);
+    assert!(o.status.success());
+    assert_eq!(records_without_wall(&fresh), records_without_wall(&out));
+}
