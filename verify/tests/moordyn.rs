@@ -64,6 +64,16 @@ fn points(v: &Value) -> Vec<Vector2<f64>> {
         .collect()
 }
 
+/// The times MoorDyn sampled at [s].
+fn sample_times(answer: &Value) -> Vec<f64> {
+    answer["samples"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_f64().unwrap())
+        .collect()
+}
+
 /// Interior rows [x, z, vx, vz] for MoorDyn's state file.
 fn rows(nodes: &[Vector2<f64>], velocities: &[Vector2<f64>]) -> Value {
     json!(
@@ -316,12 +326,7 @@ fn taut_cable_modes_match_moordyn_and_the_discrete_string() {
             "t_end": t_end, "sample": sample,
             "initial": rows(&interior, &vec![Vector2::zeros(); n - 1]),
         }));
-        let times: Vec<f64> = answer["samples"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|t| t.as_f64().unwrap())
-            .collect();
+        let times = sample_times(&answer);
         let mid = n / 2;
         let displacement = |p: Vector2<f64>| {
             if axial { p.x - rest(mid).x } else { p.y }
@@ -382,12 +387,7 @@ fn pendulum_swing_matches_moordyn() {
         "anchor": [0.0, 0.0], "end": [end.x, end.y], "end_mass": mass, "gravity": G,
         "dt": 1e-5, "t_end": 2.0, "sample": 0.01, "initial": initial,
     }));
-    let times: Vec<f64> = answer["samples"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| t.as_f64().unwrap())
-        .collect();
+    let times = sample_times(&answer);
     let theirs: Vec<Vector2<f64>> = answer["nodes"]
         .as_array()
         .unwrap()

@@ -50,6 +50,17 @@ impl HeatMap {
     }
 }
 
+/// The label of the cell whose centre is at `v` (ticks fall at cell centres and edges; edges
+/// get none).
+fn cell_label(labels: &[String], v: f64) -> String {
+    let k = v.floor() as usize;
+    if (v - k as f64 - 0.5).abs() < 1e-9 {
+        labels.get(k).cloned().unwrap_or_default()
+    } else {
+        String::new()
+    }
+}
+
 /// Viridis-like ramp from dark blue (0) to yellow (1).
 fn color(f: f64) -> RGBColor {
     const STOPS: [(f64, [f64; 3]); 5] = [
@@ -95,22 +106,8 @@ impl Drawing for HeatMap {
                 .y_label_area_size(px(44.0))
                 .build_cartesian_2d(0.0..nx as f64, 0.0..ny as f64)
                 .map_err(err)?;
-            let xl = |v: &f64| {
-                let k = v.floor() as usize;
-                if (v - k as f64 - 0.5).abs() < 1e-9 {
-                    panel.x_labels.get(k).cloned().unwrap_or_default()
-                } else {
-                    String::new()
-                }
-            };
-            let yl = |v: &f64| {
-                let k = v.floor() as usize;
-                if (v - k as f64 - 0.5).abs() < 1e-9 {
-                    panel.y_labels.get(k).cloned().unwrap_or_default()
-                } else {
-                    String::new()
-                }
-            };
+            let xl = |v: &f64| cell_label(&panel.x_labels, *v);
+            let yl = |v: &f64| cell_label(&panel.y_labels, *v);
             chart
                 .configure_mesh()
                 .disable_mesh()
