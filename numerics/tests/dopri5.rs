@@ -3,7 +3,7 @@
 //! (convergence order of the steps and of the dense output, tolerance proportionality), and the
 //! documented behaviour of the norm exclusion, the failure modes and `restart` (MODELS.md §6).
 
-use cdpr_numerics::{Dopri5, Dopri5Options, IntegratorError, OdeSystem};
+use cdpr_numerics::{Dopri5, Dopri5Options, IntegratorError, OdeSystem, Stepper};
 use proptest::prelude::*;
 
 // ---------------------------------------------------------------------------------------------
@@ -556,4 +556,19 @@ fn restart_counts_one_evaluation_and_continues_from_the_new_state() {
     let exact = 3.0 * (-(2.0 - t_r)).exp();
     // rtol 1e-10 on a contracting problem: global error within 100 × rtol × max|y| (= 3).
     assert!((d.state()[0] - exact).abs() < 100.0 * 1e-10 * 3.0);
+}
+
+/// The `Stepper` view (what the runner's event location uses) reports DOPRI5's own times.
+#[test]
+fn stepper_view_reports_the_step() {
+    fn times<S: OdeSystem, T: Stepper<S>>(t: &T) -> (f64, f64) {
+        (t.time(), t.previous_time())
+    }
+    let mut sys = Decay { lambda: -1.0 };
+    let mut d = Dopri5::new(1, fixed(0.125));
+    d.start(&mut sys, 0.0, &[1.0], 1.0).unwrap();
+    d.step(&mut sys, 1.0).unwrap();
+    d.step(&mut sys, 1.0).unwrap();
+    assert_eq!(times::<Decay, _>(&d), (0.25, 0.125));
+    assert_eq!((d.time(), d.previous_time()), (0.25, 0.125));
 }

@@ -421,3 +421,36 @@ fn dense_output_interpolates_each_step() {
     }
     assert!(worst < 1e-6, "dense output off the solution by {worst:e}");
 }
+
+/// The `Stepper` view (what the runner uses) reports the integrator's own times and state, and
+/// a step below `min_step` is refused with the step size, not taken.
+#[test]
+fn stepper_view_and_step_underflow() {
+    fn view<S: SecondOrderSystem, T: Stepper<S>>(t: &T) -> (f64, f64, Vec<f64>) {
+        (t.time(), t.previous_time(), t.state().to_vec())
+    }
+    let mut sys = Oscillator {
+        m: 1.0,
+        k: 1.0,
+        h: 0.0,
+        start: (0.0, 0.0),
+    };
+    let (_, ga) = run(&mut sys, &[1.0, 0.0, 0.0], 0.01, 1e-3, 0.9, 1e-12);
+    let (t, t_prev, y) = view::<Oscillator, _>(&ga);
+    assert_eq!((t, t_prev), (ga.time(), 0.01 - 1e-3));
+    assert_eq!(t, 0.01);
+    assert_eq!(y, ga.state());
+
+    let mut ga = GeneralizedAlpha::new(GeneralizedAlphaOptions {
+        step: 1e-3,
+        min_step: 1e-2,
+        ..GeneralizedAlphaOptions::default()
+    });
+    ga.start(&mut sys, 0.0, &[1.0, 0.0, 0.0], 1.0).unwrap();
+    let e = ga.step(&mut sys, 1.0).unwrap_err();
+    assert!(
+        e.to_string().contains("h = 1e-3 s"),
+        "the underflow names the step: {e}"
+    );
+    assert_eq!(ga.time(), 0.0, "no step was taken");
+}
