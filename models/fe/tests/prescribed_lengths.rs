@@ -47,10 +47,9 @@ impl PrescribedLengths {
             self.full[np + i] = y[nu + k];
         }
         let [d, dd, ddd] = offset(t);
-        let sign = [1.0, -1.0];
-        for c in 0..2 {
-            self.full[self.l[c]] = self.start[c] + sign[c] * d;
-            self.full[np + self.l[c]] = sign[c] * dd;
+        for (c, sign) in [1.0, -1.0].into_iter().enumerate() {
+            self.full[self.l[c]] = self.start[c] + sign * d;
+            self.full[np + self.l[c]] = sign * dd;
         }
         let mass = self.model.mass_matrix(&self.full);
         let force = self.model.force_vector(&self.full, [0.0, 0.0]);
