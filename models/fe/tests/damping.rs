@@ -86,3 +86,60 @@ fn damping_vanishes_at_rest_and_is_validated() {
         assert!(err.to_string().contains("cable.axial_damping"), "{err}");
     }
 }
+
+/// FE.5.7's law element by element, written here from the kinematics: N = max(0, EA ε + C ε')
+/// with ε = |r_b − r_a|/h − 1 and ε' = (t·(v_b − v_a) − (1 + ε) h' l')/h; the damped part the
+/// model returns is N − EA ε. Over stretching and shortening rates that cross the clip (a fast
+/// shortening taut element cannot push) and slack elements: 1e-9 N (round-off of ~1e3 N terms).
+#[test]
+fn damping_tension_is_the_clipped_kelvin_voigt_law() {
+    use cdpr_fe::element::{ElementState, Material, damping_tension};
+    use nalgebra::Vector2;
+    let mat = Material {
+        ea: 179_520.0,
+        mu: 0.013816,
+        gravity: 9.81,
+    };
+    let mut checked = [0usize; 3];
+    for i in 0..200 {
+        let f = i as f64 / 199.0;
+        let (h, damping) = (0.05, 0.5 + 2.0 * f);
+        let strain = -2e-4 + 1.2e-3 * ((7.0 * f).sin() * 0.5 + 0.5);
+        let dir = Vector2::new((3.0 * f).cos(), (3.0 * f).sin());
+        let ra = Vector2::new(0.1, -0.2);
+        let rb = ra + dir * h * (1.0 + strain);
+        let speed = 20.0 * ((11.0 * f).cos());
+        let (va, vb) = (
+            Vector2::zeros(),
+            dir * speed + Vector2::new(-dir.y, dir.x) * 0.3,
+        );
+        let (l_rate, h_prime) = (0.4 * (5.0 * f).sin(), 0.1);
+        let s = ElementState::new((ra, va), (rb, vb), l_rate, h, h_prime);
+        let (extra, _) = damping_tension(&mat, &s, damping);
+        let eps = (rb - ra).norm() / h - 1.0;
+        let t = (rb - ra) / (rb - ra).norm();
+        let eps_rate = (t.dot(&(vb - va)) - (1.0 + eps) * h_prime * l_rate) / h;
+        let (elastic, expected) = if eps > 0.0 {
+            let e = mat.ea * eps;
+            (e, (e + damping * eps_rate).max(0.0))
+        } else {
+            (0.0, 0.0)
+        };
+        assert!(
+            (elastic + extra - expected).abs() < 1e-9,
+            "ε = {eps:e}, ε' = {eps_rate:e}: N = {} against {expected}",
+            elastic + extra
+        );
+        checked[if eps <= 0.0 {
+            0
+        } else if expected == 0.0 {
+            1
+        } else {
+            2
+        }] += 1;
+    }
+    assert!(
+        checked.iter().all(|&n| n > 5),
+        "slack, clipped, taut cases: {checked:?}"
+    );
+}
