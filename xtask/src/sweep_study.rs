@@ -1,7 +1,8 @@
-//! The report's first parameter study (`examples/sweeps/mass_time_*.toml`): the paper's move on
-//! each cable model with the paper's PID and the LQR, over effector mass 0.25–4 kg × move time
-//! 0.1–0.5 s. Runs the grids with `cdpr-sweep` into `DIR/sweeps/`, draws heat maps of the
-//! vertical residual vibration and the transition error, and writes the REPORT.md section.
+//! The report's parameter studies (`examples/sweeps/*mass_time_*.toml`): the paper's move on each
+//! cable model over effector mass 0.25–4 kg × move time 0.1–0.5 s, once per controller (the
+//! paper's PID, the LQR) and once per input shaper on the PID (none, ZVD, 2-hump EI). Runs the
+//! grids with `cdpr-sweep` into `DIR/sweeps/`, draws heat maps of the vertical residual vibration
+//! and the transition error, and writes the REPORT.md section.
 
 use crate::heatmap::{HeatMap, HeatPanel};
 use anyhow::{Context, Result};
@@ -10,21 +11,48 @@ use cdpr_bench::core::scenario::Scenario;
 use cdpr_sweep::{Grid, Options, Record, Shard};
 use std::path::{Path, PathBuf};
 
-/// The controllers of the study's grids, in their `controller.kind` axis order.
-const CONTROLLERS: [&str; 2] = ["pid", "lqr"];
 const MASS: &str = "robot.effector_mass";
 const MOVE: &str = "trajectory.t2";
 
-/// The metrics drawn: key, figure name, title.
+/// One study: its grid files' stem, the axis whose values make the heat maps' rows, and the
+/// prefix of its figures.
+#[derive(Clone, Copy)]
+pub struct Spec {
+    pub stem: &'static str,
+    pub group_key: &'static str,
+    pub groups: &'static [&'static str],
+    pub figure_prefix: &'static str,
+    pub what: &'static str,
+}
+
+/// The report's two studies.
+pub const STUDIES: [Spec; 2] = [
+    Spec {
+        stem: "mass_time",
+        group_key: "controller.kind",
+        groups: &["pid", "lqr"],
+        figure_prefix: "sweep",
+        what: "the paper's PID and the LQR",
+    },
+    Spec {
+        stem: "shaper_mass_time",
+        group_key: "trajectory.shaper",
+        groups: &["none", "zvd", "2hump-ei"],
+        figure_prefix: "sweep_shaper",
+        what: "the paper's PID unshaped and with ZVD and 2-hump EI shapers designed from the modal analysis",
+    },
+];
+
+/// The metrics drawn: key, figure name suffix, title.
 const METRICS: [(&str, &str, &str); 2] = [
     (
         "z_p2p",
-        "sweep_z_p2p",
+        "z_p2p",
         "vertical residual vibration: z peak-to-peak over [t2 + 0.8 s, 5 s] [m]",
     ),
     (
         "err_max_transition",
-        "sweep_err_transition",
+        "err_transition",
         "transition error: max |x_ref − x| during the move [m]",
     ),
 ];
@@ -38,21 +66,22 @@ pub struct ModelSweep {
 }
 
 pub struct SweepStudy {
+    pub spec: Spec,
     pub sweeps: Vec<ModelSweep>,
 }
 
-fn grid_path(kind: ModelKind) -> PathBuf {
+fn grid_path(spec: &Spec, kind: ModelKind) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../examples/sweeps")
-        .join(format!("mass_time_{}.toml", kind.name()))
+        .join(format!("{}_{}.toml", spec.stem, kind.name()))
 }
 
-/// Runs the three grids afresh into `out/sweeps/mass_time_<model>/` on every core, for the
+/// Runs a study's three grids afresh into `out/sweeps/<stem>_<model>/` on every core, for the
 /// report's `simulation.t_final` (5 s for the paper; shorter for a quick report).
-pub fn compute(base: &Scenario, out: &Path) -> Result<SweepStudy> {
+pub fn compute(spec: Spec, base: &Scenario, out: &Path) -> Result<SweepStudy> {
     let mut sweeps = Vec::new();
     for kind in ModelKind::ALL {
-        let mut grid = Grid::from_file(&grid_path(kind))?;
+        let mut grid = Grid::from_file(&grid_path(&spec, kind))?;
         if let toml::Value::Table(simulation) = grid
             .base
             .entry("simulation")
@@ -78,7 +107,7 @@ pub fn compute(base: &Scenario, out: &Path) -> Result<SweepStudy> {
             },
             &mut |_, _| {},
         )
-        .with_context(|| format!("the {} mass × move-time sweep", kind.name()))?;
+        .with_context(|| format!("the {} sweep of {}", kind.name(), spec.stem))?;
         let wall_s = start.elapsed().as_secs_f64();
         let (_, records) = cdpr_sweep::store::read(&dir.join(cdpr_sweep::store::RESULTS))?;
         sweeps.push(ModelSweep {
@@ -88,7 +117,7 @@ pub fn compute(base: &Scenario, out: &Path) -> Result<SweepStudy> {
             wall_s,
         });
     }
-    Ok(SweepStudy { sweeps })
+    Ok(SweepStudy { spec, sweeps })
 }
 
 /// The values of an axis, in order.
@@ -105,8 +134,9 @@ fn param(r: &Record, key: &str) -> Option<f64> {
 }
 
 impl ModelSweep {
-    /// values[mass index][move index] of `metric` for `controller` (None: failed or null).
-    fn table(&self, controller: &str, metric: &str) -> Vec<Vec<Option<f64>>> {
+    /// values[mass index][move index] of `metric` for the group value `group` of `key` (None:
+    /// failed or null).
+    fn table(&self, key: &str, group: &str, metric: &str) -> Vec<Vec<Option<f64>>> {
         let (masses, moves) = (axis(&self.grid, MASS), axis(&self.grid, MOVE));
         masses
             .iter()
@@ -117,8 +147,7 @@ impl ModelSweep {
                         self.records
                             .iter()
                             .find(|r| {
-                                r.params.get("controller.kind").and_then(|v| v.as_str())
-                                    == Some(controller)
+                                r.params.get(key).and_then(|v| v.as_str()) == Some(group)
                                     && param(r, MASS) == Some(m)
                                     && param(r, MOVE) == Some(t)
                             })
@@ -133,7 +162,7 @@ impl ModelSweep {
 
 impl SweepStudy {
     /// Writes the heat maps; returns their names.
-    pub fn write(&self, out: &Path) -> Result<Vec<&'static str>> {
+    pub fn write(&self, out: &Path) -> Result<Vec<String>> {
         let first = &self.sweeps[0].grid;
         let x_labels: Vec<String> = axis(first, MOVE)
             .iter()
@@ -144,15 +173,17 @@ impl SweepStudy {
             .map(|m| format!("{m:.2}"))
             .collect();
         let mut names = Vec::new();
-        for (metric, name, title) in METRICS {
+        let spec = &self.spec;
+        for (metric, suffix, title) in METRICS {
+            let name = format!("{}_{suffix}", spec.figure_prefix);
             let mut panels = Vec::new();
-            for c in CONTROLLERS {
+            for g in spec.groups {
                 for s in &self.sweeps {
                     panels.push(HeatPanel {
-                        title: format!("{} · {c}", s.kind.name()),
+                        title: format!("{} · {g}", s.kind.name()),
                         x_labels: x_labels.clone(),
                         y_labels: y_labels.clone(),
-                        values: s.table(c, metric),
+                        values: s.table(spec.group_key, g, metric),
                     });
                 }
             }
@@ -161,25 +192,24 @@ impl SweepStudy {
                 x_name: "move end t2 [s]".into(),
                 y_name: "effector mass [kg]".into(),
                 value_name: "log10".into(),
-                rows: CONTROLLERS.len(),
+                rows: spec.groups.len(),
                 cols: self.sweeps.len(),
                 panels,
             };
-            crate::figures::render_drawing(&map, name, out)?;
+            crate::figures::render_drawing(&map, &name, out)?;
             names.push(name);
         }
         Ok(names)
     }
 
-    /// The REPORT.md section.
-    pub fn section(&self, figures: &[&str]) -> String {
-        let mut s = String::from(
-            "## Parameter study: effector mass × move time\n\n\
-             Beyond the paper (`cargo xtask sweep --grid examples/sweeps/mass_time_<model>.toml`; \
-             records in `sweeps/`). The paper's move x 0.5 → 0.6 m with effector mass \
-             0.25–4 kg (log) × move end t2 0.1–0.5 s, the paper's PID and the LQR, on each cable \
-             model; samples every 0.1 ms. A cross marks a point that failed (a cable went \
-             slack).\n\n",
+    /// The REPORT.md subsection.
+    pub fn section(&self, figures: &[String]) -> String {
+        let spec = &self.spec;
+        let mut s = format!(
+            "### Effector mass × move time: {}\n\n\
+             `cargo xtask sweep --grid examples/sweeps/{}_<model>.toml`; records in \
+             `sweeps/{}_<model>/`. A cross marks a point that failed (a cable went slack).\n\n",
+            spec.what, spec.stem, spec.stem
         );
         let points: usize = self.sweeps.iter().map(|s| s.records.len()).sum();
         let wall: f64 = self.sweeps.iter().map(|s| s.wall_s).sum();
@@ -190,15 +220,16 @@ impl SweepStudy {
         for f in figures {
             s.push_str(&format!("![{f}]({f}.svg)\n\n"));
         }
-        s.push_str(
-            "| model | controller | points | failed | z p2p range [µm] | transition error range [mm] |\n\
+        s.push_str(&format!(
+            "| model | {} | points | failed | z p2p range [µm] | transition error range [mm] |\n\
              |---|---|---|---|---|---|\n",
-        );
+            spec.group_key
+        ));
         for sweep in &self.sweeps {
-            for c in CONTROLLERS {
+            for &c in spec.groups {
                 let range = |metric: &str, scale: f64| {
                     let v: Vec<f64> = sweep
-                        .table(c, metric)
+                        .table(spec.group_key, c, metric)
                         .into_iter()
                         .flatten()
                         .flatten()

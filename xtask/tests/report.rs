@@ -7,9 +7,11 @@ use common::TempDir;
 use std::path::Path;
 use std::process::Command;
 
-const FIGURES: [&str; 7] = [
+const FIGURES: [&str; 9] = [
     "sweep_z_p2p",
     "sweep_err_transition",
+    "sweep_shaper_z_p2p",
+    "sweep_shaper_err_transition",
     "fig5_position",
     "fig6_error",
     "fig7_spectrum",
