@@ -244,7 +244,7 @@ impl SweepStudy {
                 let ours: Vec<&Record> = sweep
                     .records
                     .iter()
-                    .filter(|r| r.params.get("controller.kind").and_then(|v| v.as_str()) == Some(c))
+                    .filter(|r| r.params.get(spec.group_key).and_then(|v| v.as_str()) == Some(c))
                     .collect();
                 let failed = ours.iter().filter(|r| r.status != "complete").count();
                 s.push_str(&format!(
