@@ -116,6 +116,19 @@ fn cdpr_statics_match_the_continuum() {
                     c + 1
                 );
             }
+            // The stored element carries the commanded tension to the reel (a straight element
+            // on the reel line, no weight along it): its strain is T/EA and its tension T, to
+            // the Newton stop (1e-7 N).
+            let commanded = 0.5 * (200.0 + if c == 0 { -eq.force } else { eq.force });
+            let (strain, tension) = m.stored_tension(y, c).expect("elastic stored cable");
+            assert!(
+                (tension - commanded).abs() < 1e-6,
+                "stored {tension} vs {commanded}"
+            );
+            assert!(
+                (strain * m.material.ea - commanded).abs() < 1e-6,
+                "strain {strain}"
+            );
         }
         assert!(eq.residual < 1e-7);
     }
