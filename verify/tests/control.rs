@@ -450,3 +450,28 @@ fn closed_loop_iteration_matrices_match_differences_for_every_controller() {
         }
     }
 }
+
+/// Each controller's rest states are a rest: started at the static equilibrium of an
+/// off-centre position (x1 = x2 = 0.62 m, where the tensions differ and every state that holds
+/// a force is non-zero) with the reference at rest there, the elastic run stays put for 0.5 s
+/// within 1e-9 m (DOPRI5's atol level; a wrong rest state moves the effector by ~mm). Only the
+/// LQR designs gains the run reports; the fixed-gain controllers report none.
+#[test]
+fn every_controller_holds_its_rest_state_off_centre() {
+    for kind in ["pid", "pid-xz", "computed-torque", "lqr"] {
+        let s = scenario(&format!(
+            "[controller]\nkind = \"{kind}\"\n[trajectory]\nx1 = 0.62\nx2 = 0.62\n\
+             [simulation]\nt_final = 0.5\nsample_period = 1e-3\n"
+        ));
+        let run = assess(&s, &mut |_| {}).unwrap().run;
+        for channel in [Channel::X, Channel::Z] {
+            let v = run.series.column(channel).unwrap();
+            let drift = v.iter().map(|q| (q - v[0]).abs()).fold(0.0, f64::max);
+            assert!(
+                drift < 1e-9,
+                "{kind}: {channel:?} drifts {drift:e} m from rest"
+            );
+        }
+        assert_eq!(run.controller_gains.is_empty(), kind != "lqr", "{kind}");
+    }
+}
