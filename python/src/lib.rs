@@ -191,11 +191,7 @@ fn sweep<'py>(
         Some(s) => s.parse().map_err(sweep_error)?,
         None => cdpr_sweep::Shard::ALL,
     };
-    let jobs = match jobs {
-        Some(0) => return Err(ScenarioError::new_err("jobs = 0: allowed an integer ≥ 1")),
-        Some(j) => j,
-        None => cdpr_sweep::all_cores(),
-    };
+    let jobs = cdpr_sweep::jobs(jobs).map_err(sweep_error)?;
     py.detach(|| {
         cdpr_sweep::run(
             &g,

@@ -23,6 +23,9 @@ pub enum SweepError {
     /// `--shard I/N` outside 0 ≤ I < N, N ≥ 1.
     #[error("--shard {given}: {message}")]
     Shard { given: String, message: String },
+    /// No worker thread asked for.
+    #[error("--jobs 0: allowed an integer ≥ 1")]
+    Jobs,
     /// A results file that is not this grid's, or cannot be read.
     #[error("results file {path}: {message}")]
     Results { path: String, message: String },

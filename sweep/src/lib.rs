@@ -37,6 +37,6 @@ pub mod store;
 pub use error::SweepError;
 pub use grid::{Axis, Combine, Grid, Point};
 pub use record::{Record, evaluate, metrics_map};
-pub use run::{Options, Summary, all_cores, run};
+pub use run::{Options, Summary, all_cores, jobs, run};
 pub use shard::Shard;
 pub use store::{Header, merge};

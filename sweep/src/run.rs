@@ -15,7 +15,7 @@ use std::sync::mpsc;
 /// How to run a sweep.
 #[derive(Debug, Clone, Copy)]
 pub struct Options<'a> {
-    /// Worker threads (≥ 1).
+    /// Worker threads (≥ 1; 0 is an error).
     pub jobs: usize,
     pub shard: Shard,
     /// When set (a signal handler), workers take no new point and interrupt the ones running;
@@ -43,6 +43,15 @@ pub fn all_cores() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
+/// Worker threads for a requested count: every core when none is asked for; 0 is refused.
+pub fn jobs(requested: Option<usize>) -> Result<usize, SweepError> {
+    match requested {
+        Some(0) => Err(SweepError::Jobs),
+        Some(j) => Ok(j),
+        None => Ok(all_cores()),
+    }
+}
+
 /// Runs the sweep into `dir` (created if missing). `progress(done, total)` is called on the
 /// calling thread after each point.
 pub fn run(
@@ -51,22 +60,24 @@ pub fn run(
     options: Options,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Summary, SweepError> {
+    if options.jobs == 0 {
+        return Err(SweepError::Jobs);
+    }
     point::check_all(grid)?;
     std::fs::create_dir_all(dir).map_err(|e| SweepError::io(dir, e))?;
     let header = Header::of(grid);
-    let mut records: Vec<Record> = store::existing(dir, grid)?
-        .into_iter()
-        .filter(|r| options.shard.owns(r.point))
-        .collect();
+    // Every record the directory holds is kept, another shard's too: a run never drops what an
+    // earlier one computed.
+    let mut records = store::existing(dir, grid)?;
     let recorded: std::collections::HashSet<usize> = records.iter().map(|r| r.point).collect();
     let mut appender = Appender::open(dir, &header, &records)?;
+    let shard_points = (0..grid.len()).filter(|&i| options.shard.owns(i)).count();
     let pending: Vec<usize> = (0..grid.len())
         .filter(|&i| options.shard.owns(i) && !recorded.contains(&i))
         .collect();
-    let shard_points = pending.len() + records.len();
     let mut summary = Summary {
         shard_points,
-        resumed: records.len(),
+        resumed: shard_points - pending.len(),
         ran: 0,
         failed: 0,
         interrupted: false,
@@ -76,7 +87,7 @@ pub fn run(
     let mut write_error = None;
     std::thread::scope(|scope| {
         let (send, receive) = mpsc::channel::<Record>();
-        for _ in 0..options.jobs.max(1).min(pending.len().max(1)) {
+        for _ in 0..options.jobs.min(pending.len().max(1)) {
             let send = send.clone();
             let (next, pending) = (&next, &pending);
             scope.spawn(move || {
@@ -114,7 +125,7 @@ pub fn run(
     if let Some(e) = write_error {
         return Err(e);
     }
-    summary.interrupted = records.len() < shard_points;
+    summary.interrupted = summary.resumed + summary.ran < shard_points;
     store::finish(dir, &header, &mut records)?;
     Ok(summary)
 }

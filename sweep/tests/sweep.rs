@@ -87,6 +87,17 @@ fn shards_merged_and_resumed_sweeps_equal_the_one_machine_sweep() {
         );
     }
 
+    // Two shards run one after the other into one directory: the second keeps the first's
+    // records, and together they are the whole sweep.
+    let shared = tmp("shared");
+    let first = sweep(&g, &shared, 1, Shard { index: 0, count: 2 });
+    let second = sweep(&g, &shared, 1, Shard { index: 1, count: 2 });
+    assert_eq!((first.ran, second.ran, second.resumed), (3, 3, 0));
+    assert_eq!(
+        without_wall(&whole.join(RESULTS)),
+        without_wall(&shared.join(RESULTS))
+    );
+
     // An interrupted sweep: the header, two records and a torn line. The resume runs the four
     // points left and ends with the same file.
     let resumed = tmp("resumed");

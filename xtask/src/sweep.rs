@@ -17,11 +17,7 @@ pub fn run(grid_path: &Path, out: &Path, jobs: Option<usize>, shard: Option<&str
         Some(s) => s.parse::<Shard>()?,
         None => Shard::ALL,
     };
-    let jobs = match jobs {
-        Some(0) => anyhow::bail!("--jobs 0: allowed an integer ≥ 1"),
-        Some(j) => j,
-        None => cdpr_sweep::all_cores(),
-    };
+    let jobs = cdpr_sweep::jobs(jobs)?;
     ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
         .context("installing the SIGINT/SIGTERM handler")?;
     let label = format!("sweep {shard}");
