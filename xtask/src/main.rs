@@ -151,7 +151,7 @@ enum Command {
         jobs: Option<usize>,
         /// Run only shard I of N (points i with i mod N = I).
         #[arg(long)]
-        shard: Option<String>,
+        shard: Option<cdpr_sweep::Shard>,
         /// Merge these shards' result directories (or results.jsonl files) into --out.
         #[arg(long, num_args = 1.., conflicts_with_all = ["grid", "shard", "jobs"])]
         merge: Vec<PathBuf>,
@@ -184,7 +184,7 @@ fn main() -> ExitCode {
             shard,
             merge,
         } => match grid {
-            Some(grid) => sweep::run(&grid, &out, jobs, shard.as_deref()),
+            Some(grid) => sweep::run(&grid, &out, jobs, shard.unwrap_or(cdpr_sweep::Shard::ALL)),
             None => sweep::merge(&merge, &out),
         },
         Command::StaticsSweep {

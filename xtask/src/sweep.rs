@@ -11,12 +11,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 static STOP: AtomicBool = AtomicBool::new(false);
 
-pub fn run(grid_path: &Path, out: &Path, jobs: Option<usize>, shard: Option<&str>) -> Result<()> {
+pub fn run(grid_path: &Path, out: &Path, jobs: Option<usize>, shard: Shard) -> Result<()> {
     let grid = Grid::from_file(grid_path)?;
-    let shard = match shard {
-        Some(s) => s.parse::<Shard>()?,
-        None => Shard::ALL,
-    };
     let jobs = cdpr_sweep::jobs(jobs)?;
     ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
         .context("installing the SIGINT/SIGTERM handler")?;
