@@ -1,8 +1,9 @@
 //! # cdpr-testing
 //!
-//! Support shared by the test suites of cdpr-bench, never by the library: a global allocator that
-//! counts allocations, for the tests that a right-hand side allocates nothing. A test binary
-//! installs it with
+//! Support shared by the test suites of cdpr-bench, never by the library: the Python the
+//! cross-code and Python-package tests need ([`python`]), and a global allocator that counts
+//! allocations, for the tests that a right-hand side allocates nothing. A test binary installs
+//! it with
 //!
 //! ```
 //! #[global_allocator]
@@ -13,6 +14,8 @@
 //! assert_eq!(cdpr_testing::allocations(), before + 1);
 //! # drop(v);
 //! ```
+
+pub mod python;
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};

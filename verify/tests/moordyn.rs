@@ -20,6 +20,7 @@ use cdpr_bench::numerics::{Dopri5, Dopri5Options, OdeSystem};
 use cdpr_verify::irvine::Catenary;
 use serde_json::{Value, json};
 use std::io::Write;
+use std::path::Path;
 use std::process::{Command, Stdio};
 
 const EA: f64 = 179_520.0;
@@ -29,14 +30,16 @@ const G: f64 = 9.81;
 /// Runs `case` in MoorDyn (see `run_case.py` for its keys) and returns its answer.
 fn moordyn(case: Value) -> Value {
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/moordyn/run_case.py");
-    let python = std::env::var("CDPR_PYTHON").unwrap_or_else(|_| "python3".into());
+    // The tests' own Python, with MoorDyn installed under target/ the first time.
+    let target = Path::new(env!("CARGO_TARGET_TMPDIR")).parent().unwrap();
+    let python = cdpr_testing::python::interpreter(target);
     let mut child = Command::new(&python)
         .arg(script)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
-        .unwrap_or_else(|e| panic!("{python}: {e} (these tests need Python 3 with `pip install moordyn`, as .ci/run installs)"));
+        .unwrap_or_else(|e| panic!("{}: {e}", python.display()));
     child
         .stdin
         .take()
@@ -52,7 +55,10 @@ fn moordyn(case: Value) -> Value {
         stderr.lines().rev().take(15).collect::<Vec<_>>().join("\n")
     );
     serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
-        panic!("MoorDyn's answer is not JSON ({e}); is moordyn installed for {python}? {stderr}")
+        panic!(
+            "MoorDyn's answer is not JSON ({e}); is moordyn installed for {}? {stderr}",
+            python.display()
+        )
     })
 }
 
