@@ -4,7 +4,7 @@
 //! held, the start where z is free), so every controller is judged against the same straight
 //! line.
 
-use cdpr_core::channel::Channel;
+use crate::metrics::Columns;
 use cdpr_core::controller::TensionLimits;
 use cdpr_core::runner::Run;
 use std::collections::BTreeMap;
@@ -27,6 +27,9 @@ pub struct ControlContext<'a> {
     pub limits: TensionLimits,
     /// Sample period [s].
     pub sample_period: f64,
+    /// The smallest variation of a position the run resolves [m] (the integrator's absolute
+    /// tolerance): a signal that varies less over a window has no spectral peak there.
+    pub resolution: f64,
     /// The input shaper: its name, design frequency [rad/s] and damping ratio (NaN unshaped).
     pub shaper: &'a str,
     pub shaper_frequency: f64,
@@ -49,7 +52,8 @@ pub struct ControlMetrics {
     /// Extremes of both commanded tensions over the record [N].
     pub tension_min: f64,
     pub tension_max: f64,
-    /// Time with a commanded tension at a limit [s] (sample count × sample period).
+    /// Time with a commanded tension at a limit [s] (each sample standing for the sample period
+    /// around it, clipped to the record).
     pub saturated_s: f64,
     /// Largest growth rate of the closed loop's modes at the end of the move [1/s] (from the
     /// modal analysis; null where it was not done).
@@ -70,15 +74,12 @@ pub struct ControlMetrics {
 impl ControlMetrics {
     /// Computes the metrics of `run`'s samples.
     pub fn from_run(run: &Run, context: &ControlContext) -> Self {
-        let s = &run.series;
-        let col = |channel: Channel| s.column(channel).unwrap_or_default();
-        let (t, z, err, t1, t2) = (
-            col(Channel::Time),
-            col(Channel::Z),
-            col(Channel::Error),
-            col(Channel::T1),
-            col(Channel::T2),
-        );
+        Self::from_columns(&Columns::of(run), context)
+    }
+
+    /// Computes the metrics of a run's channels.
+    pub fn from_columns(c: &Columns, context: &ControlContext) -> Self {
+        let (t, z, err, t1, t2) = (c.t, c.z, c.err, c.t1, c.t2);
         let z0 = z.first().copied().unwrap_or(f64::NAN);
         let half = 0.5 * context.sample_period;
         let transition = t.partition_point(|&v| v < context.move_start - half)
@@ -97,23 +98,23 @@ impl ControlMetrics {
         let t_end = t.last().copied().unwrap_or(0.0);
         let last = t.partition_point(|&v| v < t_end - Z_MEAN_WINDOW - half);
         let z_end = mean(&z[last..]);
-        let tensions = t1.iter().chain(&t2);
+        let tensions = t1.iter().chain(t2);
         let at_limit = |v: f64| v <= context.limits.t_min || v >= context.limits.t_max;
-        let saturated = t1
+        let saturated: Vec<bool> = t1
             .iter()
-            .zip(&t2)
-            .filter(|&(&a, &b)| at_limit(a) || at_limit(b))
-            .count();
+            .zip(t2)
+            .map(|(&a, &b)| at_limit(a) || at_limit(b))
+            .collect();
         Self {
             controller: context.controller.to_owned(),
             path_err_max_transition: path,
             ex_max_transition: ex,
             ez_max_transition: ez,
-            x_settle_s: settle_time(&t, err.iter().map(|e| e.abs())),
-            z_settle_s: settle_time(&t, z.iter().map(|v| (v - z_end).abs())),
+            x_settle_s: settle_time(t, err.iter().map(|e| e.abs())),
+            z_settle_s: settle_time(t, z.iter().map(|v| (v - z_end).abs())),
             tension_min: tensions.clone().fold(f64::NAN, |m, &v| v.min(m)),
             tension_max: tensions.fold(f64::NAN, |m, &v| v.max(m)),
-            saturated_s: saturated as f64 * context.sample_period,
+            saturated_s: saturated_time(&saturated, context.sample_period),
             least_stable_growth: f64::NAN,
             least_stable_omega_rad_s: f64::NAN,
             least_stable_kind: String::new(),
@@ -124,6 +125,72 @@ impl ControlMetrics {
             controller_gains: BTreeMap::new(),
         }
     }
+
+    /// Adds to `unavailable` the metrics whose windows a record ending at `t_end` does not
+    /// reach, for a move ending at `move_end` [s] (the caller sets them NaN).
+    pub(crate) fn mark_unavailable(
+        &self,
+        move_end: f64,
+        t_end: f64,
+        unavailable: &mut Vec<(&'static str, String)>,
+    ) {
+        let transition_end = move_end + TRANSITION_TAIL;
+        if t_end < transition_end {
+            let why = format!(
+                "the run ends at {t_end} s, before the transition window ends at the move's end + {TRANSITION_TAIL} s = {transition_end} s"
+            );
+            for key in [
+                "path_err_max_transition",
+                "ex_max_transition",
+                "ez_max_transition",
+            ] {
+                unavailable.push((key, why.clone()));
+            }
+        }
+        if t_end - Z_MEAN_WINDOW < move_end {
+            let why = format!(
+                "z's settled level is its mean over the record's last {Z_MEAN_WINDOW} s, from {} s, which begins before the move ends at {move_end} s",
+                t_end - Z_MEAN_WINDOW
+            );
+            unavailable.push(("z_settle_s", why));
+        }
+        for (key, value) in [
+            ("x_settle_s", self.x_settle_s),
+            ("z_settle_s", self.z_settle_s),
+        ] {
+            if value.is_nan() {
+                let why = format!(
+                    "the deviation is still ≥ {SETTLE_BAND} m at the record's end, {t_end} s"
+                );
+                unavailable.push((key, why));
+            }
+        }
+    }
+
+    /// Sets the metric `key` to NaN; false for a key that is none of these.
+    pub(crate) fn set_nan(&mut self, key: &str) -> bool {
+        let slot = match key {
+            "path_err_max_transition" => &mut self.path_err_max_transition,
+            "ex_max_transition" => &mut self.ex_max_transition,
+            "ez_max_transition" => &mut self.ez_max_transition,
+            "x_settle_s" => &mut self.x_settle_s,
+            "z_settle_s" => &mut self.z_settle_s,
+            _ => return false,
+        };
+        *slot = f64::NAN;
+        true
+    }
+}
+
+/// Time at a limit [s]: each sample stands for the sample period centred on it, clipped to the
+/// record (so a record at a limit throughout counts its length, (n − 1)·Δt, no more).
+fn saturated_time(saturated: &[bool], sample_period: f64) -> f64 {
+    let count = saturated.iter().filter(|&&s| s).count() as f64;
+    let ends = [saturated.first(), saturated.last()]
+        .into_iter()
+        .filter(|s| s.copied() == Some(true))
+        .count() as f64;
+    (count - 0.5 * ends) * sample_period
 }
 
 /// The first sample time after the last sample whose deviation is ≥ [`SETTLE_BAND`]; the

@@ -1,14 +1,16 @@
 //! The metrics of MODELS.md §7 computed from a run's samples: the numbers the paper reports
 //! (tension extremes and settling, error, overshoot, z oscillation, spectral peaks) and the cost.
 //!
-//! Every window is defined from the scenario's move [t1, t2] and the record's end t_final
+//! Every window is defined from the move [t1, its end] and the record's end t_final
 //! ([`Windows`]), so that a key measures what its name says whatever the timing: the paper's
-//! "after 1 s" is [t2 + 0.8 s, t_final] (= [1, 5] s for its move ending at 0.2 s). A metric whose
-//! window the run does not reach, or is too short for, is NaN (null in `metrics.json`) and
-//! [`Metrics::unavailable`] says why. [`UNITS`] and the field docs below are the definitions.
+//! "after 1 s" is [move end + 0.8 s, t_final] (= [1, 5] s for its move ending at t2 = 0.2 s; a
+//! shaped move ends when its shaped reference does). A metric whose window the run does not
+//! reach, or is too short for, and a peak of a signal that has none, is NaN (null in
+//! `metrics.json`) and [`Metrics::unavailable`] says why. [`UNITS`] and the field docs below are
+//! the definitions.
 
 use crate::control_metrics::{ControlContext, ControlMetrics};
-use crate::spectrum::{Peak, Spectrum, Window};
+use crate::spectrum::{NoPeak, Peak, RefinedSpectrum, Spectrum, Window};
 use cdpr_core::channel::Channel;
 use cdpr_core::runner::Run;
 use cdpr_core::trajectory::Step5;
@@ -34,31 +36,38 @@ pub const HF_PEAKS: usize = 8;
 /// Two events of one cable closer than this are counted as chatter [s].
 pub const CHATTER_WINDOW: f64 = 1e-3;
 
-/// The windows of a run's metrics [s], each [start, end].
+/// The windows of a run's metrics [s], each [start, end]; a window the record does not reach is
+/// None (null in `metrics.json`).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Windows {
-    /// The move: [t1, t2].
+    /// The move: [t1, its end] (t2, or the end of the shaped reference where one is shaped).
     pub transition: [f64; 2],
-    /// After the move has settled: [t2 + [`SETTLE_AFTER_MOVE`], t_final].
-    pub settled: [f64; 2],
-    /// [t2 + [`STRICT_SETTLE_AFTER_MOVE`], t_final].
-    pub settled_strict: [f64; 2],
+    /// After the move has settled: [move end + [`SETTLE_AFTER_MOVE`], t_final].
+    pub settled: Option<[f64; 2]>,
+    /// [move end + [`STRICT_SETTLE_AFTER_MOVE`], t_final].
+    pub settled_strict: Option<[f64; 2]>,
     /// The record's last [`LAST_WINDOW`]: [t_final − 1 s, t_final].
-    pub last: [f64; 2],
+    pub last: Option<[f64; 2]>,
     /// The whole record: [0, t_final].
     pub record: [f64; 2],
 }
 
 impl Windows {
-    /// The windows of a move `step5` recorded until `t_end` [s].
-    pub fn new(step5: &Step5, t_end: f64) -> Self {
+    /// The windows of a move over [`move_start`, `move_end`] recorded until `t_end` [s].
+    pub fn new(move_start: f64, move_end: f64, t_end: f64) -> Self {
+        let reached = |start: f64| (start < t_end).then_some([start, t_end]);
         Self {
-            transition: [step5.t1, step5.t2],
-            settled: [step5.t2 + SETTLE_AFTER_MOVE, t_end],
-            settled_strict: [step5.t2 + STRICT_SETTLE_AFTER_MOVE, t_end],
-            last: [t_end - LAST_WINDOW, t_end],
+            transition: [move_start, move_end],
+            settled: reached(move_end + SETTLE_AFTER_MOVE),
+            settled_strict: reached(move_end + STRICT_SETTLE_AFTER_MOVE),
+            last: reached((t_end - LAST_WINDOW).max(0.0)),
             record: [0.0, t_end],
         }
+    }
+
+    /// Where the settled window starts (whether or not the record reaches it) [s].
+    pub fn settled_start(&self) -> f64 {
+        self.transition[1] + SETTLE_AFTER_MOVE
     }
 }
 
@@ -142,6 +151,9 @@ pub struct Metrics {
     /// The vibration-control metrics.
     #[serde(flatten)]
     pub control: ControlMetrics,
+    /// Why each null spectral peak is none (read into `unavailable`).
+    #[serde(skip)]
+    no_peak: Vec<(&'static str, NoPeak)>,
 }
 
 /// The unit of every key of [`Metrics`] as `metrics.json` writes it ("" for counts and names;
@@ -211,14 +223,41 @@ pub const UNITS: &[(&str, &str)] = &[
 ];
 
 /// Peak memory [B] of a run of `samples` samples × `channels` channels and its metrics: the
-/// samples themselves (8 B each), the seven columns the metrics copy out, and the two refined
-/// spectra of the settled window (Hann, [`PAD`]× zero padding: a real input and its complex
-/// transform per padded sample). The spectra dominate: 2e7 samples of 22 channels need ~20 GB.
+/// samples themselves (8 B each) and the spectra of a window as long as the record, two at a
+/// time (each ~56 B a sample: the FFT's input and output, the coefficients kept and their
+/// amplitudes). 2e7 samples of 22 channels need ~6 GB.
 pub fn memory_estimate(samples: f64, channels: usize) -> f64 {
     let series = samples * channels as f64 * 8.0;
-    let columns = 7.0 * samples * 8.0;
-    let spectra = 2.0 * PAD as f64 * samples * (8.0 + 16.0);
-    series + columns + spectra
+    let spectra = 2.0 * 56.0 * samples;
+    series + spectra
+}
+
+/// The channels of a run the metrics read.
+pub struct Columns<'a> {
+    pub t: &'a [f64],
+    pub x: &'a [f64],
+    pub z: &'a [f64],
+    pub err: &'a [f64],
+    pub t1: &'a [f64],
+    pub t2: &'a [f64],
+    pub e_residual: &'a [f64],
+}
+
+impl<'a> Columns<'a> {
+    /// The run's channels (empty where the run has none).
+    pub fn of(run: &'a Run) -> Self {
+        let s = &run.series;
+        let col = |channel: Channel| s.channel(channel).unwrap_or_default();
+        Self {
+            t: col(Channel::Time),
+            x: col(Channel::X),
+            z: col(Channel::Z),
+            err: col(Channel::Error),
+            t1: col(Channel::T1),
+            t2: col(Channel::T2),
+            e_residual: col(Channel::EResidual),
+        }
+    }
 }
 
 /// Index range of the samples with t in [a, b] (`include_end`) or [a, b), on a grid of period dt.
@@ -257,87 +296,139 @@ fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
 
-fn peak_omega(p: Option<Peak>) -> f64 {
+fn peak_to_peak(v: &[f64]) -> f64 {
+    v.iter().fold(f64::NEG_INFINITY, |m, &x| m.max(x))
+        - v.iter().fold(f64::INFINITY, |m, &x| m.min(x))
+}
+
+fn peak_omega(p: Result<Peak, NoPeak>) -> f64 {
     p.map_or(f64::NAN, |p| p.omega)
 }
 
-/// Spectra of one signal over the settled window.
-pub struct SettledSpectra {
-    pub plain: Spectrum,
-    pub refined: Spectrum,
+/// The spectral peaks of one signal over the settled window: the plain peak (rectangular
+/// window, no padding), the refined peak (Hann, [`PAD`]× padding, ω ≥ [`REFINED_FROM`]) and,
+/// for `hf` > 0, the largest local maxima of the refined spectrum above [`HF_FROM`].
+pub struct SettledPeaks {
+    pub plain: Result<Peak, NoPeak>,
+    pub refined: Result<Peak, NoPeak>,
+    pub high_frequency: Vec<Peak>,
 }
 
-impl SettledSpectra {
-    pub fn new(signal: &[f64], dt: f64) -> Self {
+impl SettledPeaks {
+    /// The peaks of `signal` sampled every `dt` [s]; none where it varies by less than
+    /// `resolution` (its spectrum is then the integrator's error).
+    pub fn new(signal: &[f64], dt: f64, hf: usize, resolution: f64) -> Self {
+        let p2p = peak_to_peak(signal);
+        if p2p < resolution {
+            let none = Err(NoPeak::Unresolved { p2p, resolution });
+            return Self {
+                plain: none,
+                refined: none,
+                high_frequency: Vec::new(),
+            };
+        }
+        let plain = Spectrum::new(signal, dt, Window::Rectangular).max_bin_peak(0.0);
+        let fine = RefinedSpectrum::new(signal, dt, PAD);
         Self {
-            plain: Spectrum::new(signal, dt, Window::Rectangular, 1),
-            refined: Spectrum::new(signal, dt, Window::Hann, PAD),
+            plain,
+            refined: fine.refined_peak(REFINED_FROM),
+            high_frequency: if hf > 0 {
+                fine.local_maxima_above(HF_FROM, hf)
+            } else {
+                Vec::new()
+            },
+        }
+    }
+
+    fn none() -> Self {
+        Self {
+            plain: Err(NoPeak::Empty),
+            refined: Err(NoPeak::Empty),
+            high_frequency: Vec::new(),
         }
     }
 }
 
+/// Events less than [`CHATTER_WINDOW`] after the previous event of the same cable.
+fn chatter(events: &[cdpr_core::model::ModelEvent]) -> usize {
+    let mut last: Vec<f64> = Vec::new();
+    let mut count = 0;
+    for e in events {
+        let slot = e.cable.saturating_sub(1);
+        if last.len() <= slot {
+            last.resize(slot + 1, f64::NEG_INFINITY);
+        }
+        if e.t - last[slot] < CHATTER_WINDOW {
+            count += 1;
+        }
+        last[slot] = e.t;
+    }
+    count
+}
+
 impl Metrics {
     /// Computes every metric of `run` sampled every `dt` [s] on the trajectory `step5`, with
-    /// the controller's `context`.
+    /// the controller's `context` (whose move end is the shaped reference's where one is shaped).
     pub fn from_run(run: &Run, step5: &Step5, dt: f64, context: &ControlContext) -> Self {
-        let s = &run.series;
-        // Every run has the common channels; an empty record gives empty columns.
-        let col = |channel: Channel| s.column(channel).unwrap_or_default();
-        let (t, x, z, err, t1, t2) = (
-            col(Channel::Time),
-            col(Channel::X),
-            col(Channel::Z),
-            col(Channel::Error),
-            col(Channel::T1),
-            col(Channel::T2),
-        );
+        let c = Columns::of(run);
+        let (t, x, z, err, t1, t2) = (c.t, c.x, c.z, c.err, c.t1, c.t2);
         let t_end = t.last().copied().unwrap_or(0.0);
+        let windows = Windows::new(context.move_start, context.move_end, t_end);
 
-        let (t1_min_time, t1_min) = extreme(&t, &t1, |a, b| a < b);
-        let (t1_max_time, t1_max) = extreme(&t, &t1, |a, b| a > b);
-        let (t2_min_time, t2_min) = extreme(&t, &t2, |a, b| a < b);
-        let (t2_max_time, t2_max) = extreme(&t, &t2, |a, b| a > b);
-        let windows = Windows::new(step5, t_end);
-        let last = window(&t, windows.last[0], t_end, true, dt);
-        let transition = window(&t, step5.t1, step5.t2, true, dt);
-        let settled = window(&t, windows.settled[0], t_end, true, dt);
-        let strict = window(&t, windows.settled_strict[0], t_end, true, dt);
-        let spectral = window(&t, windows.settled[0], t_end, false, dt);
+        let (t1_min_time, t1_min) = extreme(t, t1, |a, b| a < b);
+        let (t1_max_time, t1_max) = extreme(t, t1, |a, b| a > b);
+        let (t2_min_time, t2_min) = extreme(t, t2, |a, b| a < b);
+        let (t2_max_time, t2_max) = extreme(t, t2, |a, b| a > b);
+        let settled_start = windows.settled_start();
+        let strict_start = context.move_end + STRICT_SETTLE_AFTER_MOVE;
+        let last = window(t, t_end - LAST_WINDOW, t_end, true, dt);
+        let transition = window(t, context.move_start, context.move_end, true, dt);
+        let settled = window(t, settled_start, t_end, true, dt);
+        let strict = window(t, strict_start, t_end, true, dt);
+        let spectral = window(t, settled_start, t_end, false, dt);
 
         let direction = (step5.x2 - step5.x1).signum();
         let overshoot = x
             .iter()
             .fold(f64::NEG_INFINITY, |m, &v| m.max((v - step5.x2) * direction));
         let zs = &z[settled.clone()];
-        let z_p2p = zs.iter().fold(f64::NEG_INFINITY, |m, &v| m.max(v))
-            - zs.iter().fold(f64::INFINITY, |m, &v| m.min(v));
+        let z_p2p = peak_to_peak(zs);
 
-        let z_spec = SettledSpectra::new(&z[spectral.clone()], dt);
-        let err_spec = SettledSpectra::new(&err[spectral.clone()], dt);
-        let whole = Spectrum::new(&z, dt, Window::Rectangular, 1).max_bin(0.0);
-        let err_main = err_spec.refined.refined_peak(REFINED_FROM);
-        let err_hf = err_spec.refined.largest_local_max_above(HF_FROM);
-        let db = |p: Peak| match err_main {
-            Some(main) => 20.0 * (p.amplitude / main.amplitude).log10(),
-            None => f64::NAN,
+        // The spectra only where their windows are long enough to be read (else null below).
+        let long_enough = t_end - settled_start >= MIN_SPECTRAL_WINDOW;
+        let (z_spec, err_spec) = if long_enough {
+            (
+                SettledPeaks::new(&z[spectral.clone()], dt, 0, context.resolution),
+                SettledPeaks::new(&err[spectral], dt, HF_PEAKS, context.resolution),
+            )
+        } else {
+            (SettledPeaks::none(), SettledPeaks::none())
         };
-        let err_hf_peak_db = err_hf.map_or(f64::NAN, db);
+        let whole = if t_end >= MIN_SPECTRAL_WINDOW {
+            let p2p = peak_to_peak(z);
+            if p2p < context.resolution {
+                Err(NoPeak::Unresolved {
+                    p2p,
+                    resolution: context.resolution,
+                })
+            } else {
+                Spectrum::new(z, dt, Window::Rectangular).max_bin_peak(0.0)
+            }
+        } else {
+            Err(NoPeak::Empty)
+        };
+        let err_main = err_spec.refined;
+        let db = |p: &Peak| match err_main {
+            Ok(main) => 20.0 * (p.amplitude / main.amplitude).log10(),
+            Err(_) => f64::NAN,
+        };
+        let err_hf = err_spec.high_frequency.first().copied();
+        let err_hf_peak_db = err_hf.as_ref().map_or(f64::NAN, db);
         let err_hf_peaks = err_spec
-            .refined
-            .local_maxima_above(HF_FROM, HF_PEAKS)
-            .into_iter()
+            .high_frequency
+            .iter()
             .map(|p| [p.omega, db(p)])
             .collect();
-        let energy_residual_max = max_abs(&col(Channel::EResidual));
-        let mut last_event = [f64::NEG_INFINITY; 2];
-        let mut pulley_chatter = 0;
-        for e in &run.events {
-            let slot = &mut last_event[(e.cable - 1).min(1)];
-            if e.t - *slot < CHATTER_WINDOW {
-                pulley_chatter += 1;
-            }
-            *slot = e.t;
-        }
 
         let mut metrics = Self {
             model: run.model.to_owned(),
@@ -361,21 +452,31 @@ impl Metrics {
             overshoot,
             z_mean: mean(zs),
             z_p2p,
-            z_peak_rad_s: peak_omega(z_spec.refined.refined_peak(REFINED_FROM)),
+            z_peak_rad_s: peak_omega(z_spec.refined),
             err_peak_rad_s: peak_omega(err_main),
-            z_plain_peak_rad_s: peak_omega(z_spec.plain.max_bin(0.0)),
-            err_plain_peak_rad_s: peak_omega(err_spec.plain.max_bin(0.0)),
+            z_plain_peak_rad_s: peak_omega(z_spec.plain),
+            err_plain_peak_rad_s: peak_omega(err_spec.plain),
             z_fft_record_rad_s: peak_omega(whole),
             z_fft_record_bin: whole.map_or(0, |p| p.bin),
-            err_hf_peak_rad_s: peak_omega(err_hf),
+            no_peak: [
+                ("z_peak_rad_s", z_spec.refined),
+                ("err_peak_rad_s", err_spec.refined),
+                ("z_plain_peak_rad_s", z_spec.plain),
+                ("err_plain_peak_rad_s", err_spec.plain),
+                ("z_fft_record_rad_s", whole),
+            ]
+            .into_iter()
+            .filter_map(|(key, p)| p.err().map(|why| (key, why)))
+            .collect(),
+            err_hf_peak_rad_s: err_hf.map_or(f64::NAN, |p| p.omega),
             err_hf_peak_db,
             err_hf_peaks,
             z0: z.first().copied().unwrap_or(f64::NAN),
             f0: run.equilibrium.force,
-            energy_residual_max,
+            energy_residual_max: max_abs(c.e_residual),
             pulley_events: run.events.len(),
             pulley_energy_loss: -run.events.iter().map(|e| e.energy_change).sum::<f64>(),
-            pulley_chatter,
+            pulley_chatter: chatter(&run.events),
             rhs_evals: run.stats.rhs_evals,
             steps_accepted: run.stats.steps_accepted,
             steps_rejected: run.stats.steps_rejected,
@@ -384,89 +485,144 @@ impl Metrics {
             factorisations: run.stats.factorisations,
             pivotings: run.stats.pivotings,
             wall_s: run.wall_s,
-            control: ControlMetrics::from_run(run, context),
+            control: ControlMetrics::from_columns(&c, context),
         };
-        metrics.mark_unavailable();
+        metrics.mark_unavailable(long_enough);
         metrics
     }
 
-    /// Sets to NaN, with the reason, every metric whose window the run does not reach or fill.
-    fn mark_unavailable(&mut self) {
+    /// Sets to NaN, with the reason, every metric whose window the run does not reach or fill,
+    /// and says why each peak that is null has none.
+    fn mark_unavailable(&mut self, spectra: bool) {
         let w = self.windows;
         let t_end = w.record[1];
-        let mut unavailable = Vec::new();
-        if t_end < w.transition[1] {
-            let why = format!(
-                "the run ends at {t_end} s, before the move ends at t2 = {} s",
-                w.transition[1]
-            );
-            unavailable.push((&mut self.err_max_transition, "err_max_transition", why));
+        let move_end = w.transition[1];
+        let mut unavailable: Vec<(&'static str, String)> = Vec::new();
+        if t_end < move_end {
+            let why = format!("the run ends at {t_end} s, before the move ends at {move_end} s");
+            for key in [
+                "err_max_transition",
+                "overshoot",
+                "x_settle_s",
+                "z_settle_s",
+            ] {
+                unavailable.push((key, why.clone()));
+            }
         }
         let settled = format!(
-            "the run ends at {t_end} s, before the settled window starts at t2 + {SETTLE_AFTER_MOVE} s = {} s",
-            w.settled[0]
+            "the run ends at {t_end} s, before the settled window starts at the move's end + {SETTLE_AFTER_MOVE} s = {} s",
+            w.settled_start()
         );
-        if t_end <= w.settled[0] {
-            for (value, key) in [
-                (&mut self.err_max_settled, "err_max_settled"),
-                (&mut self.z_mean, "z_mean"),
-                (&mut self.z_p2p, "z_p2p"),
-            ] {
-                unavailable.push((value, key, settled.clone()));
+        if w.settled.is_none() {
+            for key in ["err_max_settled", "z_mean", "z_p2p"] {
+                unavailable.push((key, settled.clone()));
             }
         }
-        if t_end <= w.settled_strict[0] {
+        if w.settled_strict.is_none() {
             let why = format!(
-                "the run ends at {t_end} s, before the strict settled window starts at t2 + {STRICT_SETTLE_AFTER_MOVE} s = {} s",
-                w.settled_strict[0]
+                "the run ends at {t_end} s, before the strict settled window starts at the move's end + {STRICT_SETTLE_AFTER_MOVE} s = {} s",
+                move_end + STRICT_SETTLE_AFTER_MOVE
             );
-            unavailable.push((
-                &mut self.err_max_settled_strict,
-                "err_max_settled_strict",
-                why,
-            ));
+            unavailable.push(("err_max_settled_strict", why));
         }
-        if w.last[0] < w.settled[0] {
+        if t_end - LAST_WINDOW < w.settled_start() {
             let why = format!(
-                "the last {LAST_WINDOW} s of the record, from {} s, begins before the settled window at {} s: t_final must be ≥ t2 + {} s",
-                w.last[0],
-                w.settled[0],
+                "the last {LAST_WINDOW} s of the record, from {} s, begins before the settled window at {} s: t_final must be ≥ the move's end + {} s",
+                t_end - LAST_WINDOW,
+                w.settled_start(),
                 SETTLE_AFTER_MOVE + LAST_WINDOW
             );
-            for (value, key) in [
-                (&mut self.t1_mean_last_1s, "t1_mean_last_1s"),
-                (&mut self.t2_mean_last_1s, "t2_mean_last_1s"),
-            ] {
-                unavailable.push((value, key, why.clone()));
+            for key in ["t1_mean_last_1s", "t2_mean_last_1s"] {
+                unavailable.push((key, why.clone()));
             }
         }
-        if w.settled[1] - w.settled[0] < MIN_SPECTRAL_WINDOW {
+        let spectral = [
+            ("z_peak_rad_s", "z", "refined"),
+            ("err_peak_rad_s", "the error", "refined"),
+            ("z_plain_peak_rad_s", "z", "plain"),
+            ("err_plain_peak_rad_s", "the error", "plain"),
+        ];
+        if !spectra {
             let why = format!(
                 "the settled window [{}, {t_end}] s is shorter than the {MIN_SPECTRAL_WINDOW} s a spectral peak needs",
-                w.settled[0]
+                w.settled_start()
             );
-            for (value, key) in [
-                (&mut self.z_peak_rad_s, "z_peak_rad_s"),
-                (&mut self.err_peak_rad_s, "err_peak_rad_s"),
-                (&mut self.z_plain_peak_rad_s, "z_plain_peak_rad_s"),
-                (&mut self.err_plain_peak_rad_s, "err_plain_peak_rad_s"),
-                (&mut self.err_hf_peak_rad_s, "err_hf_peak_rad_s"),
-                (&mut self.err_hf_peak_db, "err_hf_peak_db"),
-            ] {
-                unavailable.push((value, key, why.clone()));
+            for (key, _, _) in spectral {
+                unavailable.push((key, why.clone()));
             }
-            self.err_hf_peaks.clear();
+            unavailable.push(("err_hf_peak_rad_s", why.clone()));
+            unavailable.push(("err_hf_peak_db", why));
+        } else {
+            for (key, signal, kind) in spectral {
+                if let Some((_, why)) = self.no_peak.iter().find(|(k, _)| *k == key) {
+                    let why = format!(
+                        "{signal} has no {kind} spectral peak over the settled window: {why}"
+                    );
+                    unavailable.push((key, why));
+                }
+            }
+            if self.err_hf_peak_rad_s.is_nan() {
+                let why = format!(
+                    "the error's refined spectrum has no local maximum above {HF_FROM} rad/s"
+                );
+                unavailable.push(("err_hf_peak_rad_s", why.clone()));
+                unavailable.push(("err_hf_peak_db", why));
+            } else if self.err_peak_rad_s.is_nan() {
+                let why =
+                    "its level is relative to the error's refined peak, which has none".to_string();
+                unavailable.push(("err_hf_peak_db", why));
+            }
         }
         if t_end < MIN_SPECTRAL_WINDOW {
             let why = format!(
                 "the record of {t_end} s is shorter than the {MIN_SPECTRAL_WINDOW} s a spectral peak needs"
             );
-            unavailable.push((&mut self.z_fft_record_rad_s, "z_fft_record_rad_s", why));
+            unavailable.push(("z_fft_record_rad_s", why));
+        } else if let Some((_, why)) = self
+            .no_peak
+            .iter()
+            .find(|(k, _)| *k == "z_fft_record_rad_s")
+        {
+            let why = format!("z has no plain spectral peak over the record: {why}");
+            unavailable.push(("z_fft_record_rad_s", why));
+        }
+        self.control
+            .mark_unavailable(move_end, t_end, &mut unavailable);
+        for (key, why) in unavailable {
+            if !self.set_nan(key) {
+                continue;
+            }
+            self.unavailable.entry(key).or_insert(why);
+        }
+        if self.z_fft_record_rad_s.is_nan() {
             self.z_fft_record_bin = 0;
         }
-        for (value, key, why) in unavailable {
-            *value = f64::NAN;
-            self.unavailable.insert(key, why);
+        if self.err_hf_peak_rad_s.is_nan() {
+            self.err_hf_peaks.clear();
         }
+    }
+
+    /// Sets the metric `key` to NaN; false for a key that is none of these.
+    fn set_nan(&mut self, key: &str) -> bool {
+        let slot = match key {
+            "err_max_transition" => &mut self.err_max_transition,
+            "err_max_settled" => &mut self.err_max_settled,
+            "err_max_settled_strict" => &mut self.err_max_settled_strict,
+            "overshoot" => &mut self.overshoot,
+            "z_mean" => &mut self.z_mean,
+            "z_p2p" => &mut self.z_p2p,
+            "t1_mean_last_1s" => &mut self.t1_mean_last_1s,
+            "t2_mean_last_1s" => &mut self.t2_mean_last_1s,
+            "z_peak_rad_s" => &mut self.z_peak_rad_s,
+            "err_peak_rad_s" => &mut self.err_peak_rad_s,
+            "z_plain_peak_rad_s" => &mut self.z_plain_peak_rad_s,
+            "err_plain_peak_rad_s" => &mut self.err_plain_peak_rad_s,
+            "z_fft_record_rad_s" => &mut self.z_fft_record_rad_s,
+            "err_hf_peak_rad_s" => &mut self.err_hf_peak_rad_s,
+            "err_hf_peak_db" => &mut self.err_hf_peak_db,
+            other => return self.control.set_nan(other),
+        };
+        *slot = f64::NAN;
+        true
     }
 }

@@ -9,6 +9,7 @@
 use cdpr_bench::core::closed_loop::ClosedLoop;
 use cdpr_bench::core::runner::{RunOptions, simulate_reusing};
 use cdpr_bench::core::scenario::{ControllerKind, IntegratorKind, Scenario};
+use cdpr_bench::core::series::SeriesBuffer;
 use cdpr_bench::elastic::Elastic;
 use cdpr_bench::numerics::OdeSystem;
 use cdpr_bench::{ModelKind, build, with_model_kind};
@@ -52,7 +53,7 @@ fn implicit_runs(c: &mut Criterion) {
         for kind in ControllerKind::ALL {
             let s = benchmark(kind, model);
             let opts = RunOptions::from(&s);
-            let mut buffer = Vec::new();
+            let mut buffer = SeriesBuffer::default();
             group.bench_function(format!("{}_{}_5s", kind.name(), model.name()), |b| {
                 b.iter(|| {
                     let mut sys = ClosedLoop::new(build(&s).unwrap(), &s);

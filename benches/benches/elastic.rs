@@ -4,6 +4,7 @@
 use cdpr_bench::core::closed_loop::ClosedLoop;
 use cdpr_bench::core::runner::{RunOptions, simulate, simulate_reusing};
 use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::core::series::SeriesBuffer;
 use cdpr_bench::elastic::Elastic;
 use cdpr_bench::numerics::OdeSystem;
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -38,7 +39,7 @@ fn paper_run(c: &mut Criterion) {
             black_box(run.series.len())
         })
     });
-    let mut buffer = Vec::new();
+    let mut buffer = SeriesBuffer::default();
     group.bench_function("sampled_1e-5_reused_memory", |b| {
         b.iter(|| {
             let mut sys = ClosedLoop::new(Elastic::new(&scenario), &scenario);

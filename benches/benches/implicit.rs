@@ -16,7 +16,7 @@ use cdpr_bench::core::closed_loop::ClosedLoop;
 use cdpr_bench::core::model::CableModel;
 use cdpr_bench::core::runner::{RunOptions, simulate_from, simulate_reusing};
 use cdpr_bench::core::scenario::{IntegratorKind, Scenario};
-use cdpr_bench::core::series::TimeSeries;
+use cdpr_bench::core::series::{SeriesBuffer, TimeSeries};
 use cdpr_bench::{ModelConfig, ModelKind, ModelVisitor, build, with_model};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -43,7 +43,7 @@ fn paper_runs(c: &mut Criterion) {
             let mut s = scenario(kind, None);
             s.simulation.sample_period = sample_period;
             let opts = RunOptions::from(&s);
-            let mut buffer = Vec::new();
+            let mut buffer = SeriesBuffer::default();
             group.bench_function(format!("{kind}_paper_run_5s{label}"), |b| {
                 b.iter(|| {
                     let model = build(&s).unwrap();

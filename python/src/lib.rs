@@ -105,20 +105,11 @@ fn simulate<'py>(
         })
         .map_err(error)?;
     let metrics = to_py(py, &Value::Object(map))?;
-    // The samples are stored row by row: one pass over them fills every column (a pass per
-    // column would read the whole record once per channel).
+    // The samples are stored column by column: each becomes a numpy array as it is.
     let run = &assessed.run.series;
-    let columns = py.detach(|| {
-        let mut columns: Vec<Vec<f64>> = (0..run.width())
-            .map(|_| Vec::with_capacity(run.len()))
-            .collect();
-        for i in 0..run.len() {
-            for (column, &v) in columns.iter_mut().zip(run.row(i)) {
-                column.push(v);
-            }
-        }
-        columns
-    });
+    let columns: Vec<Vec<f64>> = (0..run.width())
+        .map(|j| run.column_at(j).to_vec())
+        .collect();
     let series = PyDict::new(py);
     for (name, column) in run.names().iter().zip(columns) {
         series.set_item(name, column.into_pyarray(py))?;
@@ -167,7 +158,9 @@ fn grid(obj: &Bound<'_, PyAny>) -> PyResult<cdpr_sweep::Grid> {
 
 fn sweep_error(e: cdpr_sweep::SweepError) -> PyErr {
     match e {
-        cdpr_sweep::SweepError::Io { .. } => PyRuntimeError::new_err(e.to_string()),
+        cdpr_sweep::SweepError::Io { .. }
+        | cdpr_sweep::SweepError::Busy { .. }
+        | cdpr_sweep::SweepError::Interrupted(_) => PyRuntimeError::new_err(e.to_string()),
         _ => ScenarioError::new_err(e.to_string()),
     }
 }
@@ -201,12 +194,13 @@ fn sweep<'py>(
                 shard,
                 stop: None,
             },
-            &mut |_, _| {},
+            &mut |_| {},
         )
     })
     .map_err(sweep_error)?;
-    let (_, records) =
-        cdpr_sweep::store::read(&out.join(cdpr_sweep::store::RESULTS)).map_err(sweep_error)?;
+    let (_, mut records) = cdpr_sweep::store::read_records(&out.join(cdpr_sweep::store::RESULTS))
+        .map_err(sweep_error)?;
+    records.sort_by_key(|r| r.point);
     to_py(
         py,
         &serde_json::to_value(records).expect("records serialise"),
@@ -217,7 +211,8 @@ fn sweep<'py>(
 #[pyfunction]
 fn grid_points(grid: &Bound<'_, PyAny>) -> PyResult<usize> {
     let g = self::grid(grid)?;
-    cdpr_sweep::point::check_all(&g).map_err(sweep_error)?;
+    cdpr_sweep::point::check_all(&g, cdpr_sweep::all_cores(), None, &mut |_, _| {})
+        .map_err(sweep_error)?;
     Ok(g.len())
 }
 
@@ -259,11 +254,9 @@ fn write_results(
 ) -> PyResult<()> {
     let g = self::grid(grid)?;
     let json = to_json(records)?;
-    let mut records: Vec<cdpr_sweep::Record> = serde_json::from_value(json)
+    let records: Vec<cdpr_sweep::Record> = serde_json::from_value(json)
         .map_err(|e| ScenarioError::new_err(format!("records: {e}")))?;
-    std::fs::create_dir_all(&out)
-        .map_err(|e| PyRuntimeError::new_err(format!("{}: {e}", out.display())))?;
-    cdpr_sweep::store::finish(&out, &cdpr_sweep::Header::of(&g), &mut records).map_err(sweep_error)
+    cdpr_sweep::store::write_records(&out, &g, &records).map_err(sweep_error)
 }
 
 /// A Python object (dict, list, str, int, float, bool, None) as JSON.

@@ -41,6 +41,7 @@
 mod build;
 mod config;
 mod kind;
+pub mod memory;
 mod provenance;
 mod study;
 
@@ -51,9 +52,10 @@ pub use config::{
 pub use kind::ModelKind;
 pub use provenance::{Provenance, project_revision, revision};
 pub use study::{
-    Assessed, EndAnalysis, Error, analyse, assess, assess_observed, damping_sweep, end_analysis,
-    end_state, eq15_at_end, growth_resolution, least_damped_vertical_mode, linearise, metrics,
-    mode_as_integrated, resolve_shaper, simulate, simulate_observed,
+    Assessed, EndAnalysis, Error, analyse, assess, assess_observed, assess_observed_into,
+    damping_sweep, end_analysis, end_state, eq15_at_end, growth_resolution,
+    least_damped_vertical_mode, linearise, metrics, mode_as_integrated, prepare, resolve_shaper,
+    simulate, simulate_observed, simulate_observed_into,
 };
 
 /// The crates this one composes, for their types.

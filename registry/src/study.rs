@@ -14,8 +14,11 @@ use cdpr_analysis::modes::{Analysis, ClassifiedMode, Loop, ModeKind};
 use cdpr_core::closed_loop::ClosedLoop;
 use cdpr_core::controller::TensionLimits;
 use cdpr_core::model::{CableModel, ModelError};
-use cdpr_core::runner::{Observer, Run, RunFailure, RunOptions, simulate_observed as simulate_run};
+use cdpr_core::runner::{
+    Observer, Run, RunError, RunFailure, RunOptions, simulate_observed_reusing as simulate_run,
+};
 use cdpr_core::scenario::{Designed, IntegratorKind, ModesChoice, Scenario, ScenarioError};
+use cdpr_core::series::SeriesBuffer;
 use cdpr_core::shaper::ShaperKind;
 use cdpr_core::trajectory::Step5;
 use cdpr_elastic::eq15_frequency;
@@ -45,11 +48,23 @@ impl From<BuildError> for Error {
 
 /// As [`simulate`], watched and steered by `observer` (progress, each sample, a stop flag).
 pub fn simulate_observed(scenario: &Scenario, observer: &mut Observer) -> Result<Run, Error> {
+    simulate_observed_into(scenario, observer, SeriesBuffer::default())
+}
+
+/// As [`simulate_observed`], writing the samples into `buffer`'s memory (from
+/// [`TimeSeries::into_buffer`](cdpr_core::series::TimeSeries::into_buffer) of an earlier run):
+/// a sweep's worker then allocates its samples once.
+pub fn simulate_observed_into(
+    scenario: &Scenario,
+    observer: &mut Observer,
+    buffer: SeriesBuffer,
+) -> Result<Run, Error> {
     let scenario = &resolve_shaper(scenario)?;
     let mut sys = ClosedLoop::new(build(scenario)?, scenario);
     Ok(simulate_run(
         &mut sys,
         &RunOptions::from(scenario),
+        buffer,
         observer,
     )?)
 }
@@ -70,6 +85,10 @@ pub struct Assessed {
     pub end: EndAnalysis,
     /// The integrator that ran it.
     pub integrator: IntegratorKind,
+    /// What a reader of the metrics must know: closed-loop modes at the end of the move that
+    /// grow (beyond the cables' axial modes, which the massive models' PID loops are known to
+    /// leave growing slowly; see docs/control.md).
+    pub warnings: Vec<String>,
 }
 
 /// The modal analysis at the end of the move, which never costs a run its results: done,
@@ -123,11 +142,36 @@ pub fn assess(scenario: &Scenario, progress: &mut dyn FnMut(f64)) -> Result<Asse
 
 /// As [`assess`], watched and steered by `observer`.
 pub fn assess_observed(scenario: &Scenario, observer: &mut Observer) -> Result<Assessed, Error> {
+    assess_observed_into(scenario, observer, SeriesBuffer::default())
+}
+
+/// As [`assess_observed`], the samples written into `buffer`'s memory.
+pub fn assess_observed_into(
+    scenario: &Scenario,
+    observer: &mut Observer,
+    buffer: SeriesBuffer,
+) -> Result<Assessed, Error> {
     let scenario = &resolve_shaper(scenario)?;
     let kind = ModelConfig::from_scenario(scenario)?.kind;
-    let run = simulate_observed(scenario, observer)?;
-    let (end, least_stable) = end_analysis_and_growth(scenario);
+    let run = simulate_observed_into(scenario, observer, buffer)?;
+    let interrupted = |run: Run| {
+        let t = run.t_reached;
+        Error::Run(Box::new(RunFailure {
+            error: RunError::Interrupted { t },
+            partial: Some(run),
+        }))
+    };
+    if observer.stopped() {
+        return Err(interrupted(run));
+    }
+    let (end, modes) = end_analysis_and_modes(scenario);
+    if observer.stopped() {
+        return Err(interrupted(run));
+    }
     let mut metrics = metrics(scenario, &run);
+    let least_stable = modes
+        .iter()
+        .max_by(|p, q| p.mode.growth.total_cmp(&q.mode.growth));
     if let Some(mode) = least_stable {
         metrics.control.least_stable_growth = mode.mode.growth;
         metrics.control.least_stable_omega_rad_s = mode.mode.omega;
@@ -138,8 +182,30 @@ pub fn assess_observed(scenario: &Scenario, observer: &mut Observer) -> Result<A
         metrics,
         end,
         integrator: scenario.simulation.integrator,
+        warnings: growth_warnings(scenario, &modes),
         run,
     })
+}
+
+/// Growth rate above which a closed-loop mode is reported as growing [1/s]: it doubles within
+/// ~700 s, far above the linearisation's resolution (~1e-6 1/s, `growth_resolution`).
+pub const GROWTH_WARNING: f64 = 1e-3;
+
+/// A warning for each closed-loop mode at x2 that grows faster than [`GROWTH_WARNING`], the
+/// cables' axial modes aside.
+fn growth_warnings(scenario: &Scenario, modes: &[ClassifiedMode]) -> Vec<String> {
+    modes
+        .iter()
+        .filter(|m| m.mode.growth > GROWTH_WARNING && !matches!(m.kind, ModeKind::Axial(_)))
+        .map(|m| {
+            format!(
+                "the closed loop at x2 = {} m has a growing {} mode: growth {:.4e} 1/s at {:.4} rad/s \
+                 (the controller's gains do not stabilise it; the run's numbers describe a loop \
+                 that diverges)",
+                scenario.trajectory.x2, m.kind, m.mode.growth, m.mode.omega
+            )
+        })
+        .collect()
 }
 
 impl Assessed {
@@ -155,6 +221,7 @@ impl Assessed {
                 reason: format!("the run stopped at t = {} s", run.t_reached),
             },
             integrator: scenario.simulation.integrator,
+            warnings: Vec::new(),
             run,
         }
     }
@@ -162,36 +229,32 @@ impl Assessed {
 
 /// The end state as `[analysis] modes` chooses, its size limit and failure turned into notes.
 pub fn end_analysis(scenario: &Scenario) -> EndAnalysis {
-    end_analysis_and_growth(scenario).0
+    end_analysis_and_modes(scenario).0
 }
 
-/// [`end_analysis`] and the closed loop's least stable mode at x2 (largest growth rate), from
-/// the modal analysis that drops the frozen coordinates ([`analyse`]; None where it was not
-/// done or failed). A loop without an oscillatory mode near eq. 15 (a z loop that over-damps
-/// it) fails the end state but still has its least stable mode.
-pub fn end_analysis_and_growth(scenario: &Scenario) -> (EndAnalysis, Option<ClassifiedMode>) {
+/// [`end_analysis`] and the closed loop's modes at x2, from the modal analysis that drops the
+/// frozen coordinates ([`analyse`]; none where it was not done or failed). A loop without an
+/// oscillatory mode near eq. 15 (a z loop that over-damps it) fails the end state but still has
+/// its modes.
+pub fn end_analysis_and_modes(scenario: &Scenario) -> (EndAnalysis, Vec<ClassifiedMode>) {
     if scenario.analysis.modes == ModesChoice::Off {
         let reason = "[analysis] modes = \"off\"".into();
-        return (EndAnalysis::Skipped { reason }, None);
+        return (EndAnalysis::Skipped { reason }, Vec::new());
     }
     let end = match end_state(scenario) {
         Ok(end) => EndAnalysis::Done(end),
         Err(Error::Analysis(e @ AnalysisError::TooLarge { .. })) => {
             let reason = e.to_string();
-            return (EndAnalysis::Skipped { reason }, None);
+            return (EndAnalysis::Skipped { reason }, Vec::new());
         }
         Err(e) => EndAnalysis::Failed {
             reason: e.to_string(),
         },
     };
-    let least_stable = analyse(scenario, scenario.trajectory.x2, Loop::Closed)
-        .ok()
-        .and_then(|a| {
-            a.modes
-                .into_iter()
-                .max_by(|p, q| p.mode.growth.total_cmp(&q.mode.growth))
-        });
-    (end, least_stable)
+    let modes = analyse(scenario, scenario.trajectory.x2, Loop::Closed)
+        .map(|a| a.modes)
+        .unwrap_or_default();
+    (end, modes)
 }
 
 /// Metrics of a run of `scenario` (MODELS.md §7 and the vibration-control metrics); the
@@ -214,6 +277,7 @@ pub fn metrics(scenario: &Scenario, run: &Run) -> Metrics {
         move_end: step5.t2 + impulses.map_or(0.0, |i| i.duration()),
         limits: TensionLimits::from(&scenario.controller),
         sample_period: scenario.simulation.sample_period,
+        resolution: scenario.simulation.atol,
         shaper: t.shaper.name(),
         shaper_frequency: design(t.shaper_frequency),
         shaper_damping: design(t.shaper_damping),
@@ -258,7 +322,26 @@ pub fn resolve_shaper(scenario: &Scenario) -> Result<Scenario, Error> {
     }
     let mut unshaped = scenario.clone();
     unshaped.trajectory.shaper = ShaperKind::None;
-    let (omega, zeta) = least_damped_vertical_mode(&unshaped, t.x2)?;
+    let (omega, zeta) = least_damped_vertical_mode(&unshaped, t.x2).map_err(|e| {
+        let key = if t.shaper_frequency.value().is_none() {
+            "trajectory.shaper_frequency = \"auto\""
+        } else {
+            "trajectory.shaper_damping = \"auto\""
+        };
+        let why = match e {
+            Error::Analysis(AnalysisError::NoMode) => format!(
+                "the {} controller's closed loop at x2 = {} m has no lightly damped vertical mode \
+                 to design the shaper for (its z loop damps it): give the value",
+                scenario.controller.kind.name(),
+                t.x2
+            ),
+            e => format!("the modal analysis that designs the shaper failed: {e}; give the value"),
+        };
+        ScenarioError::Infeasible {
+            keys: key.into(),
+            why,
+        }
+    })?;
     let mut resolved = scenario.clone();
     let r = &mut resolved.trajectory;
     if r.shaper_frequency.value().is_none() {
@@ -269,6 +352,51 @@ pub fn resolve_shaper(scenario: &Scenario) -> Result<Scenario, Error> {
     }
     resolved.validate()?;
     Ok(resolved)
+}
+
+/// Everything about a scenario that can be known before its run, checked with its model: an
+/// "auto" shaper designed from the modal analysis, the start equilibrium (MODELS.md §2) found
+/// and the controller designed there. Each failure is a [`ScenarioError`] naming the keys that
+/// set it, so a run that cannot start is refused before it writes anything. Returns the
+/// scenario with its shaper resolved (what the run then uses).
+pub fn prepare(scenario: &Scenario) -> Result<Scenario, Error> {
+    let resolved = resolve_shaper(scenario)?;
+    let config = ModelConfig::from_scenario(&resolved)?;
+    let mut sys = ClosedLoop::new(build(&resolved)?, &resolved);
+    sys.initial_state()
+        .map_err(|e| start_error(&resolved, &config, e))?;
+    Ok(resolved)
+}
+
+/// The keys that set a start that failed, and why.
+fn start_error(scenario: &Scenario, config: &ModelConfig, error: ModelError) -> ScenarioError {
+    let c = &scenario.controller;
+    let keys = match &error {
+        ModelError::Control(_) => format!(
+            "controller.kind = \"{}\", q_position = {}, q_velocity = {}, q_integral = {}, r = {}",
+            c.kind.name(),
+            c.q_position,
+            c.q_velocity,
+            c.q_integral,
+            c.r
+        ),
+        _ => {
+            let elements = config
+                .elements
+                .map_or(String::new(), |n| format!(", model.elements = {n}"));
+            format!(
+                "controller.tension_sum = {}, trajectory.x1 = {}, model.kind = \"{}\"{elements}",
+                c.tension_sum,
+                scenario.trajectory.x1,
+                config.kind.name()
+            )
+        }
+    };
+    let why = match error {
+        ModelError::Control(e) => format!("the controller cannot be designed at the start: {e}"),
+        e => format!("the run cannot start: {e}"),
+    };
+    ScenarioError::Infeasible { keys, why }
 }
 
 /// The static equilibrium at x2 and the closed-loop mode nearest eq. 15 there (the effector's

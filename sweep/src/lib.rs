@@ -35,8 +35,8 @@ pub mod shard;
 pub mod store;
 
 pub use error::SweepError;
-pub use grid::{Axis, Combine, Grid, Point};
-pub use record::{Record, evaluate, metrics_map};
-pub use run::{Options, Summary, all_cores, jobs, run};
+pub use grid::{Axis, Combine, Grid, MAX_POINTS, Point, Values};
+pub use record::{Record, evaluate, evaluate_into, metrics_map};
+pub use run::{Options, Phase, Summary, all_cores, jobs, run};
 pub use shard::Shard;
-pub use store::{Header, merge};
+pub use store::{DirLock, Header, merge};

@@ -5,6 +5,8 @@
 use crate::error::SweepError;
 use crate::grid::{Grid, Point};
 use cdpr_bench::core::scenario::Scenario;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use toml::{Table, Value};
 
 /// The scenario of `point`, validated.
@@ -25,9 +27,140 @@ pub fn scenario(grid: &Grid, point: &Point) -> Result<Scenario, SweepError> {
     })
 }
 
-/// Every point's scenario checked, before any work starts; the first bad point is the error.
-pub fn check_all(grid: &Grid) -> Result<(), SweepError> {
-    (0..grid.len()).try_for_each(|i| scenario(grid, &grid.point(i)).map(|_| ()))
+/// What checking every point found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Checked {
+    /// The point whose run needs the most memory, and how much [B]
+    /// ([`cdpr_bench::memory::run_memory`]).
+    pub largest: usize,
+    pub largest_bytes: f64,
+}
+
+/// Every point's scenario checked on `jobs` threads, before any work starts, and each point's
+/// memory estimated: the lowest bad point is the error. `stop` interrupts the check (within a
+/// point's check, ~50 µs); `progress(checked, total)` is called on the calling thread.
+pub fn check_all(
+    grid: &Grid,
+    jobs: usize,
+    stop: Option<&AtomicBool>,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Checked, SweepError> {
+    let total = grid.len();
+    let next = AtomicUsize::new(0);
+    let done = AtomicUsize::new(0);
+    // The lowest failing index so far: workers take no point above it.
+    let first_bad = AtomicUsize::new(usize::MAX);
+    let failure: Mutex<Option<SweepError>> = Mutex::new(None);
+    // Per model section (kind, elements, …), the point with the most samples: the memory of
+    // a run is its samples times its model's channels.
+    let largest: Mutex<Vec<(String, f64, usize)>> = Mutex::new(Vec::new());
+    let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    let workers = jobs.clamp(1, total.max(1));
+    let running = AtomicUsize::new(workers);
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| {
+                let mut mine: Vec<(String, f64, usize)> = Vec::new();
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    if i >= total || i > first_bad.load(Ordering::Relaxed) || stopped() {
+                        break;
+                    }
+                    match scenario(grid, &grid.point(i)) {
+                        Ok(s) => {
+                            let section = toml::to_string(&s.model).unwrap_or_default();
+                            let samples = cdpr_bench::memory::samples(&s);
+                            match mine.iter_mut().find(|(m, _, _)| *m == section) {
+                                Some(slot) if slot.1 >= samples => {}
+                                Some(slot) => *slot = (section, samples, i),
+                                None => mine.push((section, samples, i)),
+                            }
+                        }
+                        Err(e) => {
+                            let mut f = failure.lock().expect("no worker panics");
+                            if i < first_bad.load(Ordering::Relaxed) {
+                                first_bad.store(i, Ordering::Relaxed);
+                                *f = Some(e);
+                            }
+                        }
+                    }
+                    done.fetch_add(1, Ordering::Relaxed);
+                }
+                running.fetch_sub(1, Ordering::Relaxed);
+                let mut all = largest.lock().expect("no worker panics");
+                for (section, samples, i) in mine {
+                    match all.iter_mut().find(|(m, _, _)| *m == section) {
+                        Some(slot) if slot.1 > samples || (slot.1 == samples && slot.2 < i) => {}
+                        Some(slot) => *slot = (section, samples, i),
+                        None => all.push((section, samples, i)),
+                    }
+                }
+            });
+        }
+        while running.load(Ordering::Relaxed) > 0 {
+            progress(done.load(Ordering::Relaxed), total);
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+    });
+    if let Some(e) = failure.into_inner().expect("no worker panics") {
+        return Err(e);
+    }
+    if stopped() {
+        return Err(SweepError::Interrupted("checking the grid's points"));
+    }
+    progress(total, total);
+    let mut checked = Checked {
+        largest: 0,
+        largest_bytes: 0.0,
+    };
+    for (_, _, i) in largest.into_inner().expect("no worker panics") {
+        let s = scenario(grid, &grid.point(i))?;
+        let bytes = cdpr_bench::memory::run_memory(&s).map_err(|e| SweepError::Point {
+            index: i,
+            params: describe(&grid.point(i)),
+            message: e.to_string(),
+        })?;
+        if bytes > checked.largest_bytes {
+            checked = Checked {
+                largest: i,
+                largest_bytes: bytes,
+            };
+        }
+    }
+    Ok(checked)
+}
+
+/// Refuses `jobs` runs at once of the grid's hungriest point when they would take more than
+/// [`cdpr_bench::memory::MEMORY_SHARE`] of the available memory, naming the point, its sample
+/// period and the worker count that fits.
+pub fn check_memory(grid: &Grid, checked: &Checked, jobs: usize) -> Result<(), SweepError> {
+    let Some(available) = cdpr_bench::memory::available_memory() else {
+        return Ok(());
+    };
+    let at_once = jobs.min(grid.len()) as f64;
+    let budget = cdpr_bench::memory::MEMORY_SHARE * available;
+    if checked.largest_bytes * at_once <= budget {
+        return Ok(());
+    }
+    let point = grid.point(checked.largest);
+    let s = scenario(grid, &point)?;
+    let fits = (budget / checked.largest_bytes).floor() as usize;
+    Err(SweepError::Memory(format!(
+        "point {} ({}) needs about {:.1} GB for its samples and metrics          (simulation.sample_period = {} s, t_final = {} s); {} at once need {:.1} GB, more than          half of the {:.1} GB available: {}",
+        checked.largest,
+        describe(&point),
+        checked.largest_bytes / 1e9,
+        s.simulation.sample_period,
+        s.simulation.t_final,
+        at_once,
+        checked.largest_bytes * at_once / 1e9,
+        available / 1e9,
+        if fits >= 1 {
+            format!("run with --jobs {fits} or fewer, or raise simulation.sample_period")
+        } else {
+            "raise simulation.sample_period or shorten simulation.t_final".to_string()
+        }
+    )))
 }
 
 /// `key = value, …` of a point, for messages.

@@ -6,6 +6,7 @@ use crate::grid::{Grid, Point};
 use crate::point;
 use cdpr_bench::core::runner::{Observer, RunError};
 use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::core::series::SeriesBuffer;
 use cdpr_bench::{Assessed, Error, ModelConfig};
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
@@ -54,12 +55,24 @@ pub fn metrics_map(scenario: &Scenario, assessed: &Assessed) -> Map<String, Valu
         "eq15_rad_s".into(),
         Value::from(cdpr_bench::eq15_at_end(scenario)),
     );
+    map.insert("warnings".into(), Value::from(assessed.warnings.clone()));
     map
 }
 
 /// Runs point `index` of `grid` metrics-only. None: the run was interrupted through `stop`
 /// (nothing to record; a resumed sweep runs it again).
 pub fn evaluate(grid: &Grid, index: usize, stop: Option<&AtomicBool>) -> Option<Record> {
+    evaluate_into(grid, index, stop, &mut SeriesBuffer::default())
+}
+
+/// As [`evaluate`], the samples written into `buffer`'s memory and handed back there (a
+/// worker's runs then allocate and fault in their samples once).
+pub fn evaluate_into(
+    grid: &Grid,
+    index: usize,
+    stop: Option<&AtomicBool>,
+    buffer: &mut SeriesBuffer,
+) -> Option<Record> {
     let point = grid.point(index);
     let start = Instant::now();
     let mut record = Record {
@@ -71,7 +84,7 @@ pub fn evaluate(grid: &Grid, index: usize, stop: Option<&AtomicBool>) -> Option<
         metrics: Map::new(),
         wall_s: 0.0,
     };
-    match run(grid, &point, stop) {
+    match run(grid, &point, stop, std::mem::take(buffer)) {
         Outcome::Done(scenario, assessed, error) => {
             record.t_reached = assessed.run.t_reached;
             record.metrics = metrics_map(&scenario, &assessed);
@@ -81,6 +94,7 @@ pub fn evaluate(grid: &Grid, index: usize, stop: Option<&AtomicBool>) -> Option<
                 record.status = "failed".into();
                 record.error = Some(e);
             }
+            *buffer = assessed.run.series.into_buffer();
         }
         Outcome::Failed(e) => {
             record.status = "failed".into();
@@ -100,9 +114,12 @@ enum Outcome {
     Interrupted,
 }
 
-fn run(grid: &Grid, point: &Point, stop: Option<&AtomicBool>) -> Outcome {
-    let scenario = match point::scenario(grid, point) {
-        Ok(s) => s,
+fn run(grid: &Grid, point: &Point, stop: Option<&AtomicBool>, buffer: SeriesBuffer) -> Outcome {
+    // Checked with its model, as `simulate` does before a run: a point that cannot start is
+    // recorded with the keys that stop it.
+    let scenario = match point::scenario(grid, point).map(|s| cdpr_bench::prepare(&s)) {
+        Ok(Ok(s)) => s,
+        Ok(Err(e)) => return Outcome::Failed(e.to_string()),
         Err(e) => return Outcome::Failed(e.to_string()),
     };
     let mut quiet = |_: f64| {};
@@ -111,7 +128,7 @@ fn run(grid: &Grid, point: &Point, stop: Option<&AtomicBool>) -> Outcome {
         on_sample: None,
         stop,
     };
-    match cdpr_bench::assess_observed(&scenario, &mut observer) {
+    match cdpr_bench::assess_observed_into(&scenario, &mut observer, buffer) {
         Ok(assessed) => Outcome::Done(Box::new(scenario), Box::new(assessed), None),
         Err(Error::Run(failure)) => match (failure.error, failure.partial) {
             (RunError::Interrupted { .. }, _) => Outcome::Interrupted,
@@ -134,7 +151,7 @@ fn run(grid: &Grid, point: &Point, stop: Option<&AtomicBool>) -> Outcome {
 }
 
 /// A point's values as JSON.
-fn params(point: &Point) -> Map<String, Value> {
+pub(crate) fn params(point: &Point) -> Map<String, Value> {
     point
         .values
         .iter()

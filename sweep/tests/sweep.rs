@@ -3,7 +3,7 @@
 //! the one-machine sweep byte for byte (wall times aside), each point's record against a
 //! separate run of its scenario, and every bad input as a named error before any point runs.
 
-use cdpr_sweep::store::{RESULTS, RESULTS_CSV, read};
+use cdpr_sweep::store::{RESULTS, RESULTS_CSV, read_records};
 use cdpr_sweep::{Grid, Options, Shard, SweepError};
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
@@ -37,7 +37,7 @@ fn sweep(grid: &Grid, dir: &Path, jobs: usize, shard: Shard) -> cdpr_sweep::Summ
             shard,
             stop: None,
         },
-        &mut |_, _| {},
+        &mut |_| {},
     )
     .unwrap()
 }
@@ -77,7 +77,7 @@ fn shards_merged_and_resumed_sweeps_equal_the_one_machine_sweep() {
         })
         .collect();
     let merged = tmp("merged");
-    let (_, n) = cdpr_sweep::merge(&shards, &merged).unwrap();
+    let (_, n) = cdpr_sweep::merge(&shards, &merged, None).unwrap();
     assert_eq!(n, 6);
     for file in [RESULTS, RESULTS_CSV] {
         assert_eq!(
@@ -158,7 +158,8 @@ fn a_failed_point_is_recorded_and_the_sweep_goes_on() {
     let dir = tmp("failed");
     let s = sweep(&g, &dir, 2, Shard::ALL);
     assert_eq!((s.ran, s.failed), (2, 1));
-    let (_, records) = read(&dir.join(RESULTS)).unwrap();
+    let (_, mut records) = read_records(&dir.join(RESULTS)).unwrap();
+    records.sort_by_key(|r| r.point);
     let failed = &records[0];
     assert_eq!(failed.status, "failed");
     let error = failed.error.as_deref().unwrap();
@@ -247,7 +248,7 @@ fn bad_points_are_refused_before_any_work() {
                 shard: Shard::ALL,
                 stop: None,
             },
-            &mut |_, _| {},
+            &mut |_| {},
         )
         .unwrap_err();
         assert!(matches!(e, SweepError::Point { .. }), "{e}");
@@ -284,19 +285,26 @@ fn bad_shards_and_foreign_results_are_named_errors() {
     for (content, needle) in [
         (
             "{\"cdpr_sweep\":1,\"grid\":\"0\",\"points\":6}\n",
+            "no format-2 header",
+        ),
+        (
+            &format!(
+                "{}\n",
+                serde_json::to_string(&cdpr_sweep::Header::of(&grid())).unwrap()
+            ),
             "another grid",
         ),
-        ("time,x\n0,1\n", "no header line"),
+        ("time,x\n0,1\n", "no format-2 header"),
         (
             &format!(
                 "{}\nnot json\n{{}}\n",
                 serde_json::to_string(&cdpr_sweep::Header::of(&other)).unwrap()
             ),
-            "line 2 is not a record",
+            "line 2: not a record",
         ),
     ] {
         std::fs::write(dir.join(RESULTS), content).unwrap();
-        let e = cdpr_sweep::run(&other, &dir, options, &mut |_, _| {})
+        let e = cdpr_sweep::run(&other, &dir, options, &mut |_| {})
             .unwrap_err()
             .to_string();
         assert!(e.contains(needle) && e.contains(RESULTS), "{e}");

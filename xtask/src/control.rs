@@ -116,7 +116,7 @@ fn run_one(s: &Scenario, controller: ControllerKind, model: ModelKind) -> Result
         .step_by(every.max(1))
         .map(|i| [t[i], err[i], z[i] - z0])
         .collect();
-    let settled = assessed.metrics.windows.settled[0];
+    let settled = assessed.metrics.windows.settled_start();
     let z_spectrum = figures::spectrum(run, Channel::Z, settled, SAMPLE_PERIOD, (2.0, 2e3));
     Ok(Entry {
         controller,
@@ -485,6 +485,7 @@ pub fn controller_color(kind: ControllerKind) -> RGBColor {
 /// `cargo xtask control --out DIR [--scenario FILE]`.
 pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     let base = crate::simulate::load_scenario(scenario, None)?;
+    crate::simulate::writable_out(out)?;
     let board = compute(&base)?;
     board.write(out)?;
     println!(

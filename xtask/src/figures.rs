@@ -12,7 +12,7 @@ use crate::output::write_atomic;
 use anyhow::{Context, Result, anyhow};
 use cdpr_bench::ModelKind;
 use cdpr_bench::analysis::metrics::PAD;
-use cdpr_bench::analysis::spectrum::{Spectrum, Window};
+use cdpr_bench::analysis::spectrum::{DenseSpectrum, Window};
 use cdpr_bench::core::channel::Channel;
 use cdpr_bench::core::runner::Run;
 use cdpr_bench::core::trajectory::Step5;
@@ -162,7 +162,7 @@ pub fn spectrum(
     if end <= start + 2 {
         return Vec::new();
     }
-    let spec = Spectrum::new(&v[start..end], dt, Window::Hann, PAD);
+    let spec = DenseSpectrum::new(&v[start..end], dt, Window::Hann, PAD);
     let buckets = MAX_POINTS;
     let (l0, l1) = (w0.ln(), w1.ln());
     let mut best = vec![(0.0f64, 0.0f64); buckets];

@@ -33,6 +33,7 @@ use std::process::ExitCode;
 #[derive(Parser)]
 #[command(
     name = "cargo xtask",
+    version,
     about = "cdpr-bench: cable-driven parallel robot benchmark"
 )]
 struct Cli {
@@ -53,9 +54,9 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
-        /// Write every K-th sample to the CSV (metrics always use every sample).
-        #[arg(long, default_value_t = 1)]
-        every: usize,
+        /// Write every K-th sample to the CSV (metrics always use every sample); K ≥ 1.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+        every: u64,
     },
     /// Run the paper scenario with every available model and write the reproduction report.
     Report {
@@ -166,7 +167,7 @@ fn main() -> ExitCode {
             model,
             out,
             every,
-        } => simulate::run(scenario.as_deref(), model, &out, every),
+        } => simulate::run(scenario.as_deref(), model, &out, every as usize),
         Command::Report { out, scenario } => report::run(scenario.as_deref(), &out),
         Command::WorkPrecision { out } => work_precision::run_study(&out),
         Command::Modes {

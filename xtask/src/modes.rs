@@ -6,8 +6,9 @@
 
 use crate::figures::{Drawing, model_color, power_label, render_drawing};
 use crate::output::write_atomic;
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Result, anyhow};
 use cdpr_bench::ModelKind;
+use cdpr_bench::analysis::AnalysisError;
 use cdpr_bench::analysis::damping::Sweep;
 use cdpr_bench::analysis::modes::{self, Analysis, ClassifiedMode, Loop, ModeKind};
 use cdpr_bench::core::Vector2;
@@ -26,6 +27,9 @@ const SWEEP_SCAN: usize = 11;
 /// Everything the modes command computes.
 pub struct ModesReport {
     pub analyses: Vec<Analysis>,
+    /// The analyses the dense eigen-solver's bound skipped (a scenario's `model.elements`
+    /// applies to both massive models: N = 400 fits FE, not lumped), each with why.
+    pub skipped: Vec<String>,
     pub sweeps: Vec<Sweep>,
     /// μ [kg/m] and EA [N] for the taut-string column.
     pub mu: f64,
@@ -38,19 +42,26 @@ pub struct ModesReport {
 /// The three models' closed- and open-loop modes at each x, and the damping sweep at `sweep_at`.
 pub fn compute(base: &Scenario, xs: &[f64], sweep_at: f64) -> Result<ModesReport> {
     let mut analyses = Vec::new();
+    let mut skipped = Vec::new();
+    let mut too_large = Vec::new();
     for &x in xs {
         for kind in ModelKind::ALL {
             let s = cdpr_bench::with_model_kind(base, kind)?;
             for feedback in [Loop::Closed, Loop::Open] {
-                analyses.push(
-                    cdpr_bench::analyse(&s, x, feedback)
-                        .map_err(|e| anyhow!("{kind} model at x = {x}: {e}"))?,
-                );
+                match cdpr_bench::analyse(&s, x, feedback) {
+                    Ok(a) => analyses.push(a),
+                    Err(cdpr_bench::Error::Analysis(e @ AnalysisError::TooLarge { .. })) => {
+                        skipped.push(format!("{kind} at x = {x} ({feedback:?} loop): {e}"));
+                        too_large.push(kind);
+                    }
+                    Err(e) => return Err(anyhow!("{kind} model at x = {x}: {e}")),
+                }
             }
         }
     }
     let sweeps = ModelKind::MASSIVE
         .into_iter()
+        .filter(|kind| !too_large.contains(kind))
         .map(|kind| {
             let s = cdpr_bench::with_model_kind(base, kind)?;
             cdpr_bench::damping_sweep(&s, sweep_at, SWEEP_RANGE, SWEEP_SCAN, SWEEP_THRESHOLD)
@@ -59,6 +70,7 @@ pub fn compute(base: &Scenario, xs: &[f64], sweep_at: f64) -> Result<ModesReport
         .collect::<Result<Vec<_>>>()?;
     Ok(ModesReport {
         analyses,
+        skipped,
         sweeps,
         mu: base.cable.mass_per_length(),
         ea: base.cable.axial_stiffness(),
@@ -84,8 +96,11 @@ pub fn run(
         Some(x) => vec![x],
         None => vec![base.trajectory.x1, base.trajectory.x2],
     };
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    crate::simulate::writable_out(out)?;
     let report = compute(&base, &xs, at.unwrap_or(base.trajectory.x2))?;
+    for note in &report.skipped {
+        eprintln!("note: skipped {note}");
+    }
     report.write_files(out)?;
     write_atomic(&out.join("modes.md"), |w| {
         writeln!(w, "# Modes of the three models\n")?;
@@ -224,6 +239,9 @@ impl ModesReport {
              with the chord l, the commanded tension T and μ_s = μ/(1 + T/EA). All modes: \
              `modes.csv`; figures: `modes_x*.svg`.\n"
         )?;
+        for note in &self.skipped {
+            writeln!(w, "Skipped: {note}.\n")?;
+        }
         if !peaks.is_empty() {
             writeln!(
                 w,

@@ -78,7 +78,7 @@ fn run_model(scenario: &Scenario, kind: ModelKind, bar: &ProgressBar) -> Result<
 
 pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     let base = load_scenario(scenario, None)?;
-    std::fs::create_dir_all(out)?;
+    crate::simulate::writable_out(out)?;
     let kinds = ModelKind::ALL;
     let (_multi, bars) = bars(&kinds);
     // One thread per model: the machine's cores run them side by side; results keep model order.
@@ -237,7 +237,7 @@ fn write_figures(
     let t_end = base.simulation.t_final;
     let dt = base.simulation.sample_period;
     let step5 = Step5::from(&base.trajectory);
-    let settled_from = Windows::new(&step5, t_end).settled[0];
+    let settled_from = Windows::new(step5.t1, step5.t2, t_end).settled_start();
     let black = RGBColor(0, 0, 0);
     let panel = |x: &str, y: &str, lines: Vec<Line>, markers: Vec<Marker>, log_y: bool| Panel {
         x_label: x.into(),

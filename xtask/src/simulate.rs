@@ -1,24 +1,30 @@
 //! `cargo xtask simulate`: one scenario → `timeseries.csv` and `metrics.json`.
 //!
-//! The run is guarded before it starts (the scenario checked whole, `--out` writable, the samples'
-//! memory against the machine's), streams its samples to `timeseries.partial.csv` while it goes
-//! (so a killed run leaves what it sampled), stops at the next step on SIGINT or SIGTERM, and
+//! The run is guarded before it starts (the scenario checked whole, then with its model: an
+//! "auto" shaper designed, the start equilibrium found and the controller designed there; `--out`
+//! locked against a second run and writable; the samples' memory against the machine's),
+//! streams its samples to `timeseries.partial.csv` while it goes (so a killed run leaves what it
+//! sampled; a failed write stops it at once), stops at the next step on SIGINT or SIGTERM, and
 //! always ends with a `metrics.json` that says whether it completed, failed or was interrupted,
 //! and where it came from.
 
 use crate::output::{Progress, csv_row, write_json};
 use anyhow::{Context, Result, bail};
-use cdpr_bench::analysis::metrics::{Metrics, UNITS, memory_estimate};
-use cdpr_bench::core::runner::{Observer, RunError, channel_names};
+use cdpr_bench::analysis::metrics::{Metrics, UNITS};
+use cdpr_bench::core::channel::heading;
+use cdpr_bench::core::runner::{Observer, RunError, channel_names, channel_units};
 use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::memory::{MEMORY_SHARE, available_memory, run_memory, samples};
 use cdpr_bench::{Assessed, EndAnalysis, Error, ModelConfig, ModelKind, Provenance};
+use cdpr_sweep::DirLock;
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Set by SIGINT/SIGTERM: the run stops after its current step.
+/// Set by SIGINT/SIGTERM, or by a failed write of the samples: the run stops after its current
+/// step.
 static STOP: AtomicBool = AtomicBool::new(false);
 
 /// The outputs of a run in `--out`; any of them left by an earlier run is removed first, so a
@@ -27,11 +33,9 @@ const TIMESERIES: &str = "timeseries.csv";
 const PARTIAL: &str = "timeseries.partial.csv";
 const METRICS: &str = "metrics.json";
 
-/// Fraction of the machine's available memory a run's samples may take.
-const MEMORY_SHARE: f64 = 0.5;
-
-/// `metrics.json`: the run's status and provenance, the §7 metrics at the top level, the units of
-/// every metric, and the modal analysis at the end of the move.
+/// `metrics.json`: the run's status and provenance, the §7 metrics at the top level (absent when
+/// the run failed before its first sample), the units of every metric, and the modal analysis at
+/// the end of the move.
 #[derive(serde::Serialize)]
 pub struct MetricsFile<'a> {
     /// "complete", "failed" or "interrupted".
@@ -42,8 +46,8 @@ pub struct MetricsFile<'a> {
     /// Time reached [s] (t_final when complete).
     pub t_reached: f64,
     pub provenance: &'a Provenance,
-    #[serde(flatten)]
-    pub metrics: &'a Metrics,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub metrics: Option<&'a Metrics>,
     /// Closed-loop vertical eigenfrequency at the x2 equilibrium [rad/s] (null: not computed).
     pub vertical_mode_rad_s: Option<f64>,
     /// Its growth rate [1/s] (negative: damped; null: not computed).
@@ -54,6 +58,8 @@ pub struct MetricsFile<'a> {
     pub modal_analysis_note: Option<&'a str>,
     /// Paper eq. 15 at x2 [rad/s].
     pub eq15_rad_s: f64,
+    /// What a reader of these numbers must know (closed-loop modes that grow).
+    pub warnings: &'a [String],
     /// Unit of every key above that has one.
     pub units: BTreeMap<&'static str, &'static str>,
 }
@@ -88,13 +94,20 @@ pub fn model_kind(scenario: &Scenario) -> Result<ModelKind> {
     Ok(ModelConfig::from_scenario(scenario)?.kind)
 }
 
-/// Creates `out`, checks that it takes files, and removes the outputs of an earlier run.
-pub fn prepare_out(out: &Path) -> Result<()> {
+/// Creates `out` and checks that it takes files (before any work, so that a study does not
+/// fail after its runs).
+pub fn writable_out(out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating --out {}", out.display()))?;
     let probe = out.join(format!(".write-probe-{}", std::process::id()));
     File::create(&probe)
         .and_then(|_| std::fs::remove_file(&probe))
-        .with_context(|| format!("--out {} is not writable", out.display()))?;
+        .with_context(|| format!("--out {} is not writable", out.display()))
+}
+
+/// Creates `out`, checks that it takes files, and removes the outputs of an earlier run (the
+/// caller holds `out`'s lock).
+pub fn prepare_out(out: &Path) -> Result<()> {
+    writable_out(out)?;
     // An earlier run's outputs, and the temporary files of atomic writes a kill interrupted
     // (`.metrics.json.tmp-PID`), which would otherwise accumulate.
     let stale = |name: &str| {
@@ -115,21 +128,20 @@ pub fn prepare_out(out: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Refuses a run whose samples (`channels` wide) and their metrics would take more than
-/// [`MEMORY_SHARE`] of the available memory, naming the estimate and the keys that set it.
-fn check_memory(scenario: &Scenario, channels: usize) -> Result<()> {
+/// Refuses a run whose samples and their metrics would take more than [`MEMORY_SHARE`] of the
+/// available memory, naming the estimate and the keys that set it.
+fn check_memory(scenario: &Scenario) -> Result<()> {
     let sim = &scenario.simulation;
-    let samples = (sim.t_final / sim.sample_period).round() + 1.0;
-    let bytes = memory_estimate(samples, channels);
+    let bytes = run_memory(scenario)?;
     if let Some(available) = available_memory()
         && bytes > MEMORY_SHARE * available
     {
         bail!(
-            "the run and its metrics need about {:.1} GB ({samples:e} samples of {channels} \
-             channels, their columns and 16×-padded spectra), more than half of the {:.1} GB \
-             available: raise simulation.sample_period (now {} s) or shorten \
-             simulation.t_final (now {} s)",
+            "the run and its metrics need about {:.1} GB ({:e} samples and their spectra), more \
+             than half of the {:.1} GB available: raise simulation.sample_period (now {} s) or \
+             shorten simulation.t_final (now {} s)",
             bytes / 1e9,
+            samples(scenario),
             available / 1e9,
             sim.sample_period,
             sim.t_final
@@ -138,15 +150,8 @@ fn check_memory(scenario: &Scenario, channels: usize) -> Result<()> {
     Ok(())
 }
 
-/// MemAvailable of /proc/meminfo [B], where there is one.
-fn available_memory() -> Option<f64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024.0)
-}
-
-/// The time series written as the run samples it, every `every`-th row.
+/// The time series written as the run samples it, every `every`-th row. A failed write stops
+/// the run ([`STOP`]) and is reported with the file's path.
 struct CsvStream {
     writer: BufWriter<File>,
     path: PathBuf,
@@ -156,14 +161,15 @@ struct CsvStream {
 }
 
 impl CsvStream {
-    fn create(path: PathBuf, names: &[String], every: usize) -> Result<Self> {
+    fn create(path: PathBuf, headings: &[String], every: usize) -> Result<Self> {
         let file = File::create(&path).with_context(|| format!("creating {}", path.display()))?;
         let mut writer = BufWriter::with_capacity(1 << 16, file);
-        writeln!(writer, "{}", names.join(","))?;
+        writeln!(writer, "{}", headings.join(","))
+            .with_context(|| format!("writing {}", path.display()))?;
         Ok(Self {
             writer,
             path,
-            every: every.max(1),
+            every,
             rows: 0,
             error: None,
         })
@@ -175,25 +181,51 @@ impl CsvStream {
             csv_row(&mut line, row);
             if let Err(e) = self.writer.write_all(line.as_bytes()) {
                 self.error = Some(e);
+                STOP.store(true, Ordering::Relaxed);
             }
         }
         self.rows += 1;
     }
 
+    /// The write error, as the run's reason.
+    fn failure(&self) -> Option<String> {
+        self.error
+            .as_ref()
+            .map(|e| format!("writing {}: {e}", self.path.display()))
+    }
+
     /// Writes the rows the stream has not seen (those of a failing step), then renames the file
-    /// into `target`.
-    fn finish(mut self, rows: impl Iterator<Item = Vec<f64>>, target: &Path) -> Result<()> {
-        for row in rows.skip(self.rows) {
+    /// into `target`. After a failed write the partial file stays as it is.
+    fn finish(
+        mut self,
+        series: &cdpr_bench::core::series::TimeSeries,
+        target: &Path,
+    ) -> Result<()> {
+        let mut row = vec![0.0; series.width()];
+        for i in self.rows..series.len() {
+            series.copy_row(i, &mut row);
             self.push(&row);
         }
-        if let Some(e) = self.error.take() {
-            return Err(e).with_context(|| format!("writing {}", self.path.display()));
+        if let Some(e) = self.failure() {
+            bail!("{e}");
         }
-        let file = self.writer.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()?;
-        std::fs::rename(&self.path, target)
+        let path = self.path.clone();
+        let file = self
+            .writer
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .and_then(|f| f.sync_all().map(|_| f))
+            .with_context(|| format!("writing {}", path.display()))?;
+        drop(file);
+        std::fs::rename(&path, target)
             .with_context(|| format!("renaming into {}", target.display()))
     }
+}
+
+/// How a run ended.
+struct Ending {
+    status: &'static str,
+    error: Option<String>,
 }
 
 pub fn run(
@@ -203,15 +235,25 @@ pub fn run(
     every: usize,
 ) -> Result<()> {
     let scenario = load_scenario(scenario, model)?;
+    // What can be known before the run: refused here, before anything is written.
+    let scenario = cdpr_bench::prepare(&scenario)?;
     let provenance = Provenance::of(&scenario)?;
+    writable_out(out)?;
+    let _lock = DirLock::acquire(out, "simulate")?;
     prepare_out(out)?;
-    let names = channel_names(&*cdpr_bench::build(&scenario)?);
-    check_memory(&scenario, names.len())?;
+    let model = cdpr_bench::build(&scenario)?;
+    let headings: Vec<String> = channel_names(&*model)
+        .iter()
+        .zip(channel_units(&*model))
+        .map(|(name, unit)| heading(name, unit))
+        .collect();
+    drop(model);
+    check_memory(&scenario)?;
     ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
         .context("installing the SIGINT/SIGTERM handler")?;
     let kind = model_kind(&scenario)?;
 
-    let mut stream = CsvStream::create(out.join(PARTIAL), &names, every)?;
+    let mut stream = CsvStream::create(out.join(PARTIAL), &headings, every)?;
     let mut progress = Progress::new(kind.name());
     let result = {
         let mut on_sample = |row: &[f64]| stream.push(row);
@@ -224,48 +266,108 @@ pub fn run(
         cdpr_bench::assess_observed(&scenario, &mut observer)
     };
     progress.finish();
-
-    let (assessed, status, error) = match result {
-        Ok(assessed) => (assessed, "complete", None),
+    let write_failure = stream.failure();
+    let (assessed, ending) = match result {
+        Ok(assessed) => (
+            Some(assessed),
+            Ending {
+                status: "complete",
+                error: None,
+            },
+        ),
         Err(Error::Run(failure)) => {
-            let status = match failure.error {
-                RunError::Interrupted { .. } => "interrupted",
-                _ => "failed",
+            let ending = match (&write_failure, &failure.error) {
+                (Some(e), _) => Ending {
+                    status: "failed",
+                    error: Some(e.clone()),
+                },
+                (None, RunError::Interrupted { .. }) => Ending {
+                    status: "interrupted",
+                    error: Some(failure.error.to_string()),
+                },
+                (None, e) => Ending {
+                    status: "failed",
+                    error: Some(e.to_string()),
+                },
             };
-            let Some(run) = failure.partial else {
-                bail!("{}", failure.error);
-            };
-            let assessed = Assessed::partial(&scenario, kind, run);
-            (assessed, status, Some(failure.error.to_string()))
+            let assessed = failure
+                .partial
+                .map(|run| Assessed::partial(&scenario, kind, run));
+            (assessed, ending)
         }
-        Err(e) => return Err(e.into()),
+        Err(e) => (
+            None,
+            Ending {
+                status: "failed",
+                error: Some(e.to_string()),
+            },
+        ),
     };
-    let run = &assessed.run;
-    let series = &run.series;
-    stream.finish(
-        (0..series.len()).map(|i| series.row(i).to_vec()),
-        &out.join(TIMESERIES),
-    )?;
-    let end = assessed.end.state();
+    let written = match &assessed {
+        Some(a) => stream.finish(&a.run.series, &out.join(TIMESERIES)),
+        None => stream.finish(
+            &cdpr_bench::core::series::TimeSeries::new(Vec::new()),
+            &out.join(TIMESERIES),
+        ),
+    };
+    write_metrics(out, &scenario, &provenance, assessed.as_ref(), &ending)?;
+    written?;
+    if let Some(a) = &assessed {
+        report(a, out);
+    }
+    match ending.error {
+        None => Ok(()),
+        Some(e) => bail!(
+            "{e}; {} run kept up to t = {} s in {} and {}",
+            ending.status,
+            assessed.as_ref().map_or(0.0, |a| a.run.t_reached),
+            out.join(TIMESERIES).display(),
+            out.join(METRICS).display()
+        ),
+    }
+}
+
+/// `metrics.json` for the run's ending.
+fn write_metrics(
+    out: &Path,
+    scenario: &Scenario,
+    provenance: &Provenance,
+    assessed: Option<&Assessed>,
+    ending: &Ending,
+) -> Result<()> {
+    let end = assessed.and_then(|a| a.end.state());
+    let none = EndAnalysis::Skipped {
+        reason: "the run failed before its first sample".into(),
+    };
+    let analysis = assessed.map_or(&none, |a| &a.end);
     write_json(
         &out.join(METRICS),
         &MetricsFile {
-            status,
-            error: error.clone(),
-            t_reached: run.t_reached,
-            provenance: &provenance,
-            metrics: &assessed.metrics,
+            status: ending.status,
+            error: ending.error.clone(),
+            t_reached: assessed.map_or(0.0, |a| a.run.t_reached),
+            provenance,
+            metrics: assessed.map(|a| &a.metrics),
             vertical_mode_rad_s: end.map(|e| e.mode.omega),
             vertical_mode_growth: end.map(|e| e.mode.growth),
-            modal_analysis: assessed.end.status(),
-            modal_analysis_note: assessed.end.reason(),
-            eq15_rad_s: cdpr_bench::eq15_at_end(&scenario),
+            modal_analysis: analysis.status(),
+            modal_analysis_note: analysis.reason(),
+            eq15_rad_s: cdpr_bench::eq15_at_end(scenario),
+            warnings: assessed.map_or(&[], |a| &a.warnings),
             units: units(),
         },
-    )?;
+    )
+}
+
+/// The run's summary on stdout, its notes and warnings on stderr.
+fn report(assessed: &Assessed, out: &Path) {
     if let EndAnalysis::Skipped { reason } | EndAnalysis::Failed { reason } = &assessed.end {
         eprintln!("note: modal analysis {}: {reason}", assessed.end.status());
     }
+    for w in &assessed.warnings {
+        eprintln!("warning: {w}");
+    }
+    let run = &assessed.run;
     println!(
         "{}: {} samples, {} RHS evaluations, {} accepted / {} rejected steps, {} Newton iterations, {} matrix evaluations, {} factorisations ({} pivoting), {} events, {:.3} s wall → {}",
         run.model,
@@ -281,13 +383,4 @@ pub fn run(
         run.wall_s,
         out.display()
     );
-    match error {
-        None => Ok(()),
-        Some(e) => bail!(
-            "{e}; {status} run kept up to t = {} s in {} and {}",
-            run.t_reached,
-            out.join(TIMESERIES).display(),
-            out.join(METRICS).display()
-        ),
-    }
 }

@@ -5,20 +5,29 @@
 
 use crate::output::Progress;
 use anyhow::{Context, Result};
-use cdpr_sweep::{Grid, Options, Shard};
+use cdpr_sweep::{Grid, Options, Phase, Shard};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 static STOP: AtomicBool = AtomicBool::new(false);
 
 pub fn run(grid_path: &Path, out: &Path, jobs: Option<usize>, shard: Shard) -> Result<()> {
-    let grid = Grid::from_file(grid_path)?;
-    let jobs = cdpr_sweep::jobs(jobs)?;
     ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
         .context("installing the SIGINT/SIGTERM handler")?;
+    let grid = Grid::from_file(grid_path)?;
+    let jobs = cdpr_sweep::jobs(jobs)?;
+    // The check shows progress only where it takes a while (~50 µs a point).
+    let mut checking: Option<Progress> = None;
+    let mut running: Option<Progress> = None;
     let label = format!("sweep {shard}");
-    let mut bar = Progress::new(&label);
     let start = std::time::Instant::now();
+    let fraction = |done: usize, total: usize| {
+        if total == 0 {
+            1.0
+        } else {
+            done as f64 / total as f64
+        }
+    };
     let summary = cdpr_sweep::run(
         &grid,
         out,
@@ -27,17 +36,21 @@ pub fn run(grid_path: &Path, out: &Path, jobs: Option<usize>, shard: Shard) -> R
             shard,
             stop: Some(&STOP),
         },
-        &mut |done, total| {
-            bar.set(if total == 0 {
-                1.0
-            } else {
-                done as f64 / total as f64
-            })
+        &mut |phase| match phase {
+            Phase::Checking(done, total) if total >= 10_000 => checking
+                .get_or_insert_with(|| Progress::new("checking points"))
+                .set(fraction(done, total)),
+            Phase::Checking(..) => {}
+            Phase::Running(done, total) => running
+                .get_or_insert_with(|| Progress::new(&label))
+                .set(fraction(done, total)),
         },
     )?;
-    bar.finish();
+    for bar in [&checking, &running].into_iter().flatten() {
+        bar.finish();
+    }
     let elapsed = start.elapsed().as_secs_f64();
-    eprintln!(
+    println!(
         "{} of {} points of shard {shard} recorded ({} resumed, {} run in {elapsed:.1} s on {jobs} \
          workers, {:.1} points/s, {} failed) → {}",
         summary.resumed + summary.ran,
@@ -58,8 +71,10 @@ pub fn run(grid_path: &Path, out: &Path, jobs: Option<usize>, shard: Shard) -> R
 }
 
 pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<()> {
-    let (header, n) = cdpr_sweep::merge(inputs, out)?;
-    eprintln!(
+    ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
+        .context("installing the SIGINT/SIGTERM handler")?;
+    let (header, n) = cdpr_sweep::merge(inputs, out, Some(&STOP))?;
+    println!(
         "merged {} inputs: {n} of {} points → {}",
         inputs.len(),
         header.points,

@@ -105,11 +105,11 @@ pub fn compute(spec: Spec, base: &Scenario, out: &Path) -> Result<SweepStudy> {
                 shard: Shard::ALL,
                 stop: None,
             },
-            &mut |_, _| {},
+            &mut |_| {},
         )
         .with_context(|| format!("the {} sweep of {}", kind.name(), spec.stem))?;
         let wall_s = start.elapsed().as_secs_f64();
-        let (_, records) = cdpr_sweep::store::read(&dir.join(cdpr_sweep::store::RESULTS))?;
+        let (_, records) = cdpr_sweep::store::read_records(&dir.join(cdpr_sweep::store::RESULTS))?;
         sweeps.push(ModelSweep {
             kind,
             grid,
@@ -125,7 +125,11 @@ fn axis(grid: &Grid, key: &str) -> Vec<f64> {
     grid.axes
         .iter()
         .find(|a| a.key == key)
-        .map(|a| a.values.iter().filter_map(|v| v.as_float()).collect())
+        .map(|a| {
+            (0..a.values.len())
+                .filter_map(|k| a.values.get(k).as_float())
+                .collect()
+        })
         .unwrap_or_default()
 }
 

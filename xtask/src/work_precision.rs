@@ -80,7 +80,7 @@ fn error(run: &Run, reference: &Run) -> Result<f64> {
 }
 
 pub fn run_study(out: &Path) -> Result<()> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    crate::simulate::writable_out(out)?;
     let mut points = Vec::new();
     for model in ModelKind::MASSIVE {
         eprintln!("{model}: reference (DOPRI5, rtol {REFERENCE_RTOL:e})");

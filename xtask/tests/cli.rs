@@ -34,7 +34,10 @@ fn simulate_writes_timeseries_and_metrics() {
     let csv = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
     let mut lines = csv.lines();
     let header = lines.next().unwrap();
-    assert!(header.starts_with("t,x_ref,x,z,error,F,T1,T2,"), "{header}");
+    assert!(
+        header.starts_with("t [s],x_ref [m],x [m],z [m],error [m],F [N],T1 [N],T2 [N],"),
+        "{header}"
+    );
     assert_eq!(lines.count(), 12001, "samples at 0, 1e-4, …, 1.2 s");
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
@@ -328,7 +331,7 @@ fn modes_takes_the_controller() {
 #[test]
 fn shaping_writes_the_study() {
     let dir = TempDir::new("shaping");
-    let out = run_short(&dir, "shaping", 1.6);
+    let out = run_short(&dir, "shaping", 2.3);
     let csv = std::fs::read_to_string(out.join("shaping.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv
         .lines()

@@ -205,44 +205,38 @@ fn out_is_checked_first_and_stale_outputs_are_removed() {
     assert_eq!(m["status"], "failed");
     assert!(m["error"].as_str().unwrap().contains("slack"));
     let csv = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
-    assert!(csv.starts_with("t,x_ref,"), "the new run's partial series");
+    assert!(
+        csv.starts_with("t [s],x_ref [m],"),
+        "the new run's partial series"
+    );
     assert!(
         !out.join(".metrics.json.tmp-99999").exists(),
         "stale temporary file kept"
     );
 }
 
-/// MemAvailable of /proc/meminfo [B].
-fn available_memory() -> f64 {
-    let info = std::fs::read_to_string("/proc/meminfo").unwrap();
-    let line = info
-        .lines()
-        .find(|l| l.starts_with("MemAvailable:"))
-        .unwrap();
-    line.split_whitespace()
-        .nth(1)
-        .unwrap()
-        .parse::<f64>()
-        .unwrap()
-        * 1024.0
-}
-
-/// The smallest sample period the scenario allows (2e7 samples over 5 s) needs about 19 GB for
-/// the samples, their columns and the padded spectra: more than half of this 24 GB machine, so
-/// the run is refused before it starts, with the estimate and the key to change.
+/// The smallest sample period the scenario allows (2e7 samples over 5 s) needs ~5 GB for the
+/// samples and their spectra. Under a memory cap of 4 GB (`CDPR_MEMORY_LIMIT`, what a batch
+/// job's allocation sets where the node's MemAvailable does not know it) the run is refused
+/// before it starts, with the estimate and the key to change; nothing is written.
 #[test]
 fn a_run_that_would_exhaust_memory_is_refused_before_it_starts() {
     let dir = TempDir::new("memory");
     let scenario = scenario_file(&dir, "fine.toml", "[simulation]\nsample_period = 2.5e-7\n");
-    let samples = 2e7 + 1.0;
-    let estimate = cdpr_bench::analysis::metrics::memory_estimate(samples, 18);
-    assert!(estimate > 1.9e10, "{estimate}");
-    if estimate <= 0.5 * available_memory() {
-        eprintln!("this machine has room for the run: nothing to refuse");
-        return;
-    }
+    let estimate =
+        cdpr_bench::memory::run_memory(&cdpr_bench::scenario_from_file(&scenario).unwrap())
+            .unwrap();
+    assert!(estimate > 4e9, "{estimate}");
     let started = Instant::now();
-    let output = simulate(&scenario, &dir.join("out"));
+    let out = dir.join("out");
+    let output = xtask()
+        .args(["simulate", "--scenario"])
+        .arg(&scenario)
+        .arg("--out")
+        .arg(&out)
+        .env(cdpr_bench::memory::LIMIT_VARIABLE, "4e9")
+        .output()
+        .unwrap();
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success(), "{stderr}");
     assert!(
@@ -253,6 +247,7 @@ fn a_run_that_would_exhaust_memory_is_refused_before_it_starts() {
         started.elapsed() < Duration::from_secs(5),
         "refused before the run"
     );
+    assert!(!out.join("metrics.json").exists() && !out.join("timeseries.partial.csv").exists());
 }
 
 /// Spawns the FE paper run (DOPRI5, ~10 s) and waits until it has streamed samples.
@@ -341,7 +336,7 @@ fn a_killed_run_leaves_a_readable_partial_series() {
     signal(&child, "-KILL");
     child.wait().unwrap();
     let csv = std::fs::read_to_string(out.join("timeseries.partial.csv")).unwrap();
-    assert!(csv.starts_with("t,x_ref,x,z,"));
+    assert!(csv.starts_with("t [s],x_ref [m],x [m],z [m],"));
     assert!(complete_rows(&csv) > 1000);
     assert!(!out.join("metrics.json").exists());
     let short = scenario_file(&dir, "short.toml", "[simulation]\nt_final = 0.01\n");

@@ -150,17 +150,31 @@ fn the_slurm_array_script_covers_the_grid() {
         "/../examples/slurm/sweep.sbatch"
     );
     let out = dir.join("array");
+    // Slurm runs a copy of the script from its spool directory: the binary is found under the
+    // directory sbatch was run from (a checkout with target/release/xtask), not the job's.
+    let submit = dir.join("checkout");
+    std::fs::create_dir_all(submit.join("target/release")).unwrap();
+    std::os::unix::fs::symlink(
+        env!("CARGO_BIN_EXE_xtask"),
+        submit.join("target/release/xtask"),
+    )
+    .unwrap();
     for task in 0..3 {
-        let o = Command::new("bash")
-            .arg(script)
+        let mut c = Command::new("bash");
+        c.arg(script)
             .arg(&grid)
             .arg(&out)
-            .env("XTASK", env!("CARGO_BIN_EXE_xtask"))
             .env("SLURM_ARRAY_TASK_ID", task.to_string())
             .env("SLURM_ARRAY_TASK_COUNT", "3")
-            .env("SLURM_CPUS_PER_TASK", "1")
-            .output()
-            .unwrap();
+            .env("SLURM_CPUS_PER_TASK", "1");
+        if task == 0 {
+            c.env("SLURM_SUBMIT_DIR", &submit)
+                .env_remove("XTASK")
+                .current_dir("/");
+        } else {
+            c.env("XTASK", env!("CARGO_BIN_EXE_xtask"));
+        }
+        let o = c.output().unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
     let merged = dir.join("merged");

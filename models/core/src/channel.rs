@@ -130,6 +130,45 @@ impl Channel {
     }
 }
 
+impl Channel {
+    /// The channel's SI unit ("" where a model sets it: lumped storage counts nodes, FE's is a
+    /// length).
+    pub fn unit(self) -> &'static str {
+        match self {
+            Channel::Time => "s",
+            Channel::XRef | Channel::X | Channel::Z | Channel::Error | Channel::LFree(_) => "m",
+            Channel::Force | Channel::T1 | Channel::T2 => "N",
+            Channel::TEffector(_) | Channel::TPulley(_) => "N",
+            Channel::EKinetic
+            | Channel::EElastic
+            | Channel::EGravity
+            | Channel::WReel
+            | Channel::EDissipated
+            | Channel::EResidual => "J",
+            Channel::Stored(_) => "",
+        }
+    }
+
+    /// The channel called `name`, if it is one of these.
+    pub fn named(name: &str) -> Option<Channel> {
+        Self::COMMON
+            .into_iter()
+            .chain(Self::ENERGY)
+            .chain(Self::CABLE)
+            .find(|c| c.name() == name)
+    }
+}
+
+/// A CSV column heading: the channel's name and, where it has one, its unit in brackets
+/// ("t [s]", "stored_1 [nodes]").
+pub fn heading(name: &str, unit: &str) -> String {
+    if unit.is_empty() {
+        name.to_owned()
+    } else {
+        format!("{name} [{unit}]")
+    }
+}
+
 impl std::fmt::Display for Channel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())

@@ -160,6 +160,15 @@ pub trait CableModel {
     /// Values of [`CableModel::channel_names`] for `state` under the tensions `[T1, T2]`.
     fn channels(&self, state: &[f64], tensions: [f64; 2], out: &mut [f64]);
 
+    /// The unit of each of [`CableModel::channel_names`] ("" for a count or a ratio); by
+    /// default [`crate::channel::Channel::unit`] of the channels named alike, "" for others.
+    fn channel_units(&self) -> Vec<&'static str> {
+        self.channel_names()
+            .iter()
+            .map(|n| crate::channel::Channel::named(n).map_or("", |c| c.unit()))
+            .collect()
+    }
+
     /// The model's second-order form for the implicit integrator, if it offers one (its state is
     /// then `[q | q']`).
     fn second_order(&self) -> Option<&dyn SecondOrderForm> {
@@ -237,6 +246,9 @@ impl<M: CableModel + ?Sized> CableModel for Box<M> {
     }
     fn channels(&self, state: &[f64], tensions: [f64; 2], out: &mut [f64]) {
         (**self).channels(state, tensions, out)
+    }
+    fn channel_units(&self) -> Vec<&'static str> {
+        (**self).channel_units()
     }
     fn second_order(&self) -> Option<&dyn SecondOrderForm> {
         (**self).second_order()

@@ -7,7 +7,7 @@ use crate::closed_loop::ClosedLoop;
 use crate::controller::Controller;
 use crate::model::{CableModel, Equilibrium, ModelError, ModelEvent};
 use crate::scenario::{ImplicitMethod, IntegratorKind, Scenario};
-use crate::series::TimeSeries;
+use crate::series::{SeriesBuffer, TimeSeries};
 use cdpr_numerics::{
     Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions, IntegratorError, SolverStats,
     Stepper,
@@ -20,12 +20,10 @@ use std::time::Instant;
 pub enum RunError {
     #[error(transparent)]
     Model(#[from] ModelError),
-    #[error("integrator failed at t = {t} s: {source}")]
-    Integrator {
-        t: f64,
-        #[source]
-        source: IntegratorError,
-    },
+    /// The integrator's error is part of the message (not a `source`, which a chain would print
+    /// twice).
+    #[error("integrator failed at t = {t} s: {error}")]
+    Integrator { t: f64, error: IntegratorError },
     /// The effector left the workspace below the pulleys, 0 < x < d, z < 0 (a run gone
     /// unstable: its numbers past here describe no robot).
     #[error(
@@ -180,6 +178,14 @@ pub fn channel_names<M: CableModel + ?Sized>(model: &M) -> Vec<String> {
     names
 }
 
+/// The units of [`channel_names`], in order.
+pub fn channel_units<M: CableModel + ?Sized>(model: &M) -> Vec<&'static str> {
+    let mut units: Vec<&'static str> = Channel::COMMON.map(Channel::unit).to_vec();
+    units.extend(model.channel_units());
+    units.extend(Channel::ENERGY.map(Channel::unit));
+    units
+}
+
 /// Receives one sample row (the run's channels, in order).
 pub type SampleSink<'a> = dyn FnMut(&[f64]) + 'a;
 
@@ -206,15 +212,18 @@ impl<'a> Observer<'a> {
         }
     }
 
-    fn stopped(&self) -> bool {
+    /// Whether the stop flag is set.
+    pub fn stopped(&self) -> bool {
         self.stop.is_some_and(|s| s.load(Ordering::Relaxed))
     }
 
-    /// Hands the rows of `series` from `from` on to `on_sample`.
-    fn emit(&mut self, series: &TimeSeries, from: usize) {
+    /// Hands the rows of `series` from `from` on to `on_sample`, through `row`.
+    fn emit(&mut self, series: &TimeSeries, from: usize, row: &mut Vec<f64>) {
         if let Some(sink) = self.on_sample.as_mut() {
+            row.resize(series.width(), 0.0);
             for i in from..series.len() {
-                sink(series.row(i));
+                series.copy_row(i, row);
+                sink(row);
             }
         }
     }
@@ -228,7 +237,7 @@ pub fn simulate<M: CableModel>(
     opts: &RunOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Run, Box<RunFailure>> {
-    simulate_reusing(sys, opts, Vec::new(), progress)
+    simulate_reusing(sys, opts, SeriesBuffer::default(), progress)
 }
 
 /// The loop's MODELS.md §2 initial state, or the failure of a run that could not start.
@@ -249,8 +258,18 @@ pub fn simulate_observed<M: CableModel>(
     opts: &RunOptions,
     observer: &mut Observer,
 ) -> Result<Run, Box<RunFailure>> {
+    simulate_observed_reusing(sys, opts, SeriesBuffer::default(), observer)
+}
+
+/// As [`simulate_observed`], writing the samples into `buffer`'s memory.
+pub fn simulate_observed_reusing<M: CableModel>(
+    sys: &mut ClosedLoop<M>,
+    opts: &RunOptions,
+    buffer: SeriesBuffer,
+    observer: &mut Observer,
+) -> Result<Run, Box<RunFailure>> {
     let (y0, equilibrium) = initial_state(sys)?;
-    integrate_and_sample(sys, y0, equilibrium, opts, Vec::new(), observer)
+    integrate_and_sample(sys, y0, equilibrium, opts, buffer, observer)
 }
 
 /// As [`simulate`], writing the samples into `buffer`'s memory (from [`TimeSeries::into_buffer`]
@@ -258,7 +277,7 @@ pub fn simulate_observed<M: CableModel>(
 pub fn simulate_reusing<M: CableModel>(
     sys: &mut ClosedLoop<M>,
     opts: &RunOptions,
-    buffer: Vec<f64>,
+    buffer: SeriesBuffer,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Run, Box<RunFailure>> {
     let (y0, equilibrium) = initial_state(sys)?;
@@ -286,7 +305,7 @@ pub fn simulate_from<M: CableModel>(
         y0,
         equilibrium,
         opts,
-        Vec::new(),
+        SeriesBuffer::default(),
         &mut Observer::progress(progress),
     )
 }
@@ -296,7 +315,7 @@ fn integrate_and_sample<M: CableModel>(
     y0: Vec<f64>,
     equilibrium: Equilibrium,
     opts: &RunOptions,
-    buffer: Vec<f64>,
+    buffer: SeriesBuffer,
     observer: &mut Observer,
 ) -> Result<Run, Box<RunFailure>> {
     let start = Instant::now();
@@ -391,13 +410,14 @@ fn integrate<M: CableModel>(
     events: &mut Vec<ModelEvent>,
     observer: &mut Observer,
 ) -> Result<(), RunError> {
-    let integrator = |t: f64| move |source| RunError::Integrator { t, source };
+    let integrator = |t: f64| move |error| RunError::Integrator { t, error };
     stepper
         .start(sys, 0.0, y0, t_end)
         .map_err(integrator(0.0))?;
     let mut monitor = EventMonitor::new(sys, y0);
+    let mut row = Vec::new();
     sampler.sample_through(sys, stepper, 0.0)?;
-    observer.emit(&sampler.series, 0);
+    observer.emit(&sampler.series, 0, &mut row);
     while stepper.time() < t_end {
         if observer.stopped() {
             return Err(RunError::Interrupted { t: stepper.time() });
@@ -409,7 +429,7 @@ fn integrate<M: CableModel>(
         let Some((index, t_event)) = monitor.earliest_crossing(sys, stepper) else {
             let t = stepper.time();
             sampler.sample_through(sys, stepper, t)?;
-            observer.emit(&sampler.series, taken);
+            observer.emit(&sampler.series, taken, &mut row);
             check_slack(t, sys.command(t, stepper.state()).tensions)?;
             monitor.accept(sys, stepper.state());
             (observer.progress)(t / t_end);
@@ -418,7 +438,7 @@ fn integrate<M: CableModel>(
         // Samples up to the event come from the step as integrated; the event changes the state
         // there and the integrator restarts from it, abandoning the rest of the step.
         sampler.sample_through(sys, stepper, t_event)?;
-        observer.emit(&sampler.series, taken);
+        observer.emit(&sampler.series, taken, &mut row);
         let mut y = vec![0.0; y0.len()];
         stepper.dense_output(t_event, &mut y);
         let n = sys.model_len();

@@ -1,31 +1,56 @@
-//! Sampled output channels of a run, stored row by row (one contiguous buffer, appended once per
-//! sample) and read by column for analysis.
+//! Sampled output channels of a run, stored column by column (each channel one contiguous
+//! array, appended once per sample) so that an analysis reads a channel as a slice, without a
+//! strided copy out of 22-wide rows.
 
 use crate::channel::Channel;
 
+/// The memory of a finished series, handed to the next run (see [`TimeSeries::with_buffer`]).
+#[derive(Debug, Default)]
+pub struct SeriesBuffer(Vec<Vec<f64>>);
+
 /// Named channels sampled on a common time grid; channel 0 is the time t [s].
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct TimeSeries {
     names: Vec<String>,
-    data: Vec<f64>,
+    columns: Vec<Vec<f64>>,
+    /// One row being filled (see [`TimeSeries::push_row_with`]).
+    scratch: Vec<f64>,
+}
+
+/// Two series are equal when their channels and samples are.
+impl PartialEq for TimeSeries {
+    fn eq(&self, other: &Self) -> bool {
+        self.names == other.names && self.columns == other.columns
+    }
 }
 
 impl TimeSeries {
-    /// An empty series with room for `rows` samples, in `buffer`'s memory (e.g. from
-    /// [`TimeSeries::into_buffer`] of a previous run; `Vec::new()` for fresh memory): a sweep then
-    /// allocates and faults in its output memory once, not once per run.
-    pub fn with_buffer(names: Vec<String>, rows: usize, mut buffer: Vec<f64>) -> Self {
-        buffer.clear();
-        buffer.reserve(rows * names.len());
+    /// An empty series with room for `rows` samples, in `buffer`'s memory (from
+    /// [`TimeSeries::into_buffer`] of a previous run; `SeriesBuffer::default()` for fresh
+    /// memory): a sweep then allocates and faults in its output memory once, not once per run.
+    pub fn with_buffer(names: Vec<String>, rows: usize, buffer: SeriesBuffer) -> Self {
+        let mut columns = buffer.0;
+        columns.resize_with(names.len(), Vec::new);
+        for column in &mut columns {
+            column.clear();
+            column.reserve(rows);
+        }
+        let scratch = vec![0.0; names.len()];
         Self {
             names,
-            data: buffer,
+            columns,
+            scratch,
         }
     }
 
+    /// An empty series of these channels.
+    pub fn new(names: Vec<String>) -> Self {
+        Self::with_buffer(names, 0, SeriesBuffer::default())
+    }
+
     /// The sample storage, for reuse by the next run.
-    pub fn into_buffer(self) -> Vec<f64> {
-        self.data
+    pub fn into_buffer(self) -> SeriesBuffer {
+        SeriesBuffer(self.columns)
     }
 
     /// Channel names, in column order.
@@ -40,30 +65,39 @@ impl TimeSeries {
 
     /// Number of samples.
     pub fn len(&self) -> usize {
-        self.data.len().checked_div(self.width()).unwrap_or(0)
+        self.columns.first().map_or(0, Vec::len)
     }
 
     pub fn is_empty(&self) -> bool {
-        self.data.is_empty()
+        self.len() == 0
     }
 
     /// Appends one sample; `row` has one value per channel.
     pub fn push_row(&mut self, row: &[f64]) {
         assert_eq!(row.len(), self.width(), "row width");
-        self.data.extend_from_slice(row);
+        for (column, &v) in self.columns.iter_mut().zip(row) {
+            column.push(v);
+        }
     }
 
-    /// Appends one sample written in place by `fill` (no intermediate row, no copy).
+    /// Appends one sample written by `fill` into a row of the series' width.
     pub fn push_row_with(&mut self, fill: impl FnOnce(&mut [f64])) {
-        let start = self.data.len();
-        self.data.resize(start + self.width(), 0.0);
-        fill(&mut self.data[start..]);
+        fill(&mut self.scratch);
+        for (column, &v) in self.columns.iter_mut().zip(&self.scratch) {
+            column.push(v);
+        }
+    }
+
+    /// Sample `i`, all channels, copied into `row` (of the series' width).
+    pub fn copy_row(&self, i: usize, row: &mut [f64]) {
+        for (slot, column) in row.iter_mut().zip(&self.columns) {
+            *slot = column[i];
+        }
     }
 
     /// Sample `i`, all channels.
-    pub fn row(&self, i: usize) -> &[f64] {
-        let w = self.width();
-        &self.data[i * w..(i + 1) * w]
+    pub fn row(&self, i: usize) -> Vec<f64> {
+        self.columns.iter().map(|c| c[i]).collect()
     }
 
     /// Index of `channel`, if the run has it.
@@ -76,22 +110,29 @@ impl TimeSeries {
         self.names.iter().position(|n| n == name)
     }
 
-    /// A copy of `channel`, if the run has it (every run has [`Channel::COMMON`] and
+    /// The samples of `channel`, if the run has it (every run has [`Channel::COMMON`] and
     /// [`Channel::ENERGY`]; the massive-cable models also [`Channel::CABLE`]).
+    pub fn channel(&self, channel: Channel) -> Option<&[f64]> {
+        self.channel_named(channel.name())
+    }
+
+    /// The samples of the channel called `name` (a model's own channel), if there is one.
+    pub fn channel_named(&self, name: &str) -> Option<&[f64]> {
+        Some(&self.columns[self.index_named(name)?])
+    }
+
+    /// The samples of channel `j` (in column order).
+    pub fn column_at(&self, j: usize) -> &[f64] {
+        &self.columns[j]
+    }
+
+    /// A copy of `channel`, if the run has it.
     pub fn column(&self, channel: Channel) -> Option<Vec<f64>> {
-        self.column_named(channel.name())
+        self.channel(channel).map(<[f64]>::to_vec)
     }
 
     /// A copy of the channel called `name` (a model's own channel), if there is one.
     pub fn column_named(&self, name: &str) -> Option<Vec<f64>> {
-        let j = self.index_named(name)?;
-        Some(
-            self.data
-                .iter()
-                .skip(j)
-                .step_by(self.width())
-                .copied()
-                .collect(),
-        )
+        self.channel_named(name).map(<[f64]>::to_vec)
     }
 }

@@ -9,7 +9,7 @@
 use cdpr_core::controller::split_tensions;
 use cdpr_core::modal_layout::{Dof, ModalLayout};
 use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError, ModelParams};
-use cdpr_core::scenario::{Scenario, ScenarioError};
+use cdpr_core::scenario::{IntegratorKind, Scenario, ScenarioError, out_of_range};
 use cdpr_numerics::newton::{self, NewtonOptions, StaticProblem};
 use nalgebra::Vector2;
 
@@ -38,7 +38,17 @@ pub struct Params {}
 
 impl ModelParams for Params {
     type Model = Elastic;
-    fn validate(&self, _scenario: &Scenario) -> Result<(), ScenarioError> {
+    /// The massless cables have no second-order form, so no implicit path: refused here rather
+    /// than when the run starts.
+    fn validate(&self, scenario: &Scenario) -> Result<(), ScenarioError> {
+        if scenario.simulation.integrator == IntegratorKind::Implicit {
+            return Err(out_of_range(
+                "simulation.integrator",
+                "\"implicit\"",
+                "\"dopri5\" for the elastic model: its massless cables have no second-order form \
+                 for the implicit path (nor its stiffness: DOPRI5 runs it in ~1 ms)",
+            ));
+        }
         Ok(())
     }
     fn build(&self, scenario: &Scenario) -> Result<Elastic, ModelError> {
@@ -233,6 +243,10 @@ impl CableModel for Elastic {
     /// commanded tension to the effector unchanged, so no separate effector-end tension is stored.
     fn channel_names(&self) -> Vec<String> {
         ["l1", "l2", "l0_1", "l0_2"].map(String::from).to_vec()
+    }
+
+    fn channel_units(&self) -> Vec<&'static str> {
+        vec!["m"; 4]
     }
 
     fn channels(&self, y: &[f64], tensions: [f64; 2], out: &mut [f64]) {

@@ -584,6 +584,16 @@ impl CableModel for Fe {
             .to_vec()
     }
 
+    fn channel_units(&self) -> Vec<&'static str> {
+        use cdpr_core::channel::Channel;
+        Channel::CABLE
+            .map(|c| match c {
+                Channel::Stored(_) => "m",
+                c => c.unit(),
+            })
+            .to_vec()
+    }
+
     fn second_order(&self) -> Option<&dyn cdpr_core::second_order::SecondOrderForm> {
         Some(self)
     }

@@ -161,7 +161,9 @@ impl Controller {
                 corner(self.velocity_filter)?;
                 positive("controller.q_position", self.q_position)?;
                 non_negative("controller.q_velocity", self.q_velocity)?;
-                non_negative("controller.q_integral", self.q_integral)?;
+                // Without a weight the integral states are not detectable: the CARE has no
+                // stabilising solution and the design fails.
+                positive("controller.q_integral", self.q_integral)?;
                 positive("controller.r", self.r)?;
             }
         }

@@ -16,12 +16,10 @@ use std::path::Path;
 /// Why a scenario was refused.
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {
-    #[error("cannot read scenario file {path}: {source}")]
-    Io {
-        path: String,
-        #[source]
-        source: std::io::Error,
-    },
+    /// The OS error is part of the message, not a `source`: printed with its chain it would
+    /// otherwise appear twice.
+    #[error("cannot read scenario file {path}: {error}")]
+    Io { path: String, error: std::io::Error },
     /// Malformed TOML, an unknown key or a value of the wrong type (the message names the key).
     #[error("invalid scenario file: {0}")]
     Syntax(String),
@@ -32,6 +30,10 @@ pub enum ScenarioError {
         value: String,
         allowed: String,
     },
+    /// Values each in range that together cannot start a run (no start equilibrium, no
+    /// controller design, no mode for an "auto" shaper), found before the run.
+    #[error("scenario keys {keys}: {why}")]
+    Infeasible { keys: String, why: String },
 }
 
 pub fn out_of_range(
@@ -364,9 +366,9 @@ impl Scenario {
 
     /// Reads, parses and validates a scenario file.
     pub fn from_file(path: &Path) -> Result<Self, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+        let text = std::fs::read_to_string(path).map_err(|error| ScenarioError::Io {
             path: path.display().to_string(),
-            source,
+            error,
         })?;
         Self::from_toml_str(&text)
     }
@@ -376,7 +378,9 @@ impl Scenario {
         let r = &self.robot;
         positive("robot.anchor_distance", r.anchor_distance)?;
         positive("robot.effector_mass", r.effector_mass)?;
-        non_negative("robot.gravity", r.gravity)?;
+        // The effector hangs below the pulleys on taut cables: without gravity it has no rest
+        // below them (the run left the workspace at t = 0).
+        positive("robot.gravity", r.gravity)?;
 
         let c = &self.cable;
         positive("cable.youngs_modulus", c.youngs_modulus)?;
