@@ -108,6 +108,8 @@ thread_local! {
 struct Cache {
     plans: HashMap<usize, Arc<dyn RealToComplex<f64>>>,
     windows: HashMap<(usize, Window), Arc<Vec<f64>>>,
+    /// The gridding's pre-scale e^{τs²}/√(4πτ) per length ([`RefinedSpectrum`]).
+    prescales: HashMap<usize, Arc<Vec<f64>>>,
     buffers: Buffers,
 }
 
@@ -127,6 +129,25 @@ impl Cache {
         self.plans
             .entry(len)
             .or_insert_with(|| RealFftPlanner::new().plan_fft_forward(len))
+            .clone()
+    }
+
+    fn prescale(&mut self, n: usize) -> Arc<Vec<f64>> {
+        if !self.prescales.contains_key(&n) && self.prescales.len() >= CACHED_LENGTHS {
+            self.prescales.clear();
+        }
+        self.prescales
+            .entry(n)
+            .or_insert_with(|| {
+                let tau = gridding_tau(n);
+                let centre = 0.5 * (n - 1) as f64;
+                let norm = 1.0 / (4.0 * PI * tau).sqrt();
+                let weights = (0..n).map(|t| {
+                    let s = t as f64 - centre;
+                    (tau * s * s).exp() * norm
+                });
+                Arc::new(weights.collect())
+            })
             .clone()
     }
 
@@ -324,6 +345,11 @@ const SPREAD: i64 = 12;
 /// 2×-oversampled grid: a = πW/(2√2); both ~3e-12 at W = 12.
 const GRID_WIDTH: f64 = PI * SPREAD as f64 / (2.0 * std::f64::consts::SQRT_2);
 
+/// The Gaussian's τ for `n` samples.
+fn gridding_tau(n: usize) -> f64 {
+    GRID_WIDTH / (n as f64 * n as f64)
+}
+
 /// The Hann-windowed spectrum of a signal zero-padded to `pad`·n points (MODELS.md §7's refined
 /// spectrum), each value computed when asked, to ~1e-11 of the spectrum's largest, with the
 /// unpadded spectrum to say where its peaks can be.
@@ -340,6 +366,9 @@ pub struct RefinedSpectrum {
     /// The one-sided 2n-point transform of u (before its centring phase).
     gridded: Vec<Complex<f64>>,
     tau: f64,
+    /// e^{−h²k²/(4τ)}, k = 0 … 2W: the factor of the fast Gaussian gridding (Greengard & Lee)
+    /// that does not depend on the value's frequency.
+    tail: [f64; 2 * SPREAD as usize + 1],
     /// 2/Σw.
     scale: f64,
 }
@@ -357,24 +386,29 @@ impl RefinedSpectrum {
                 n,
                 gridded: Vec::new(),
                 tau: 0.0,
+                tail: [0.0; 2 * SPREAD as usize + 1],
                 scale: 0.0,
             };
         }
         let (mut y, weight_sum) = windowed(signal, Window::Hann);
         let coarse = Spectrum::of_windowed(&y, weight_sum, dt);
-        let tau = GRID_WIDTH / (n as f64 * n as f64);
-        let centre = 0.5 * (n - 1) as f64;
-        let norm = 1.0 / (4.0 * PI * tau).sqrt();
-        for (t, v) in y.iter_mut().enumerate() {
-            let s = t as f64 - centre;
-            *v *= (tau * s * s).exp() * norm;
+        let prescale = CACHE.with(|c| c.borrow_mut().prescale(n));
+        for (v, w) in y.iter_mut().zip(prescale.iter()) {
+            *v *= w;
         }
+        let tau = gridding_tau(n);
+        let h = 2.0 * PI / (OVERSAMPLING * n) as f64;
+        let tail = std::array::from_fn(|k| {
+            let d = h * k as f64;
+            (-d * d / (4.0 * tau)).exp()
+        });
         Self {
             coarse,
             pad,
             n,
             gridded: fft(&y, OVERSAMPLING * n, <[_]>::to_vec),
             tau,
+            tail,
             scale: 2.0 / weight_sum,
         }
     }
@@ -402,30 +436,39 @@ impl RefinedSpectrum {
         self.len() == 0
     }
 
-    /// U_k, the centred transform of u, for any integer k (periodic, conjugate-symmetric).
+    /// V_k, the transform of u, for any integer k (periodic, conjugate-symmetric).
     fn gridded(&self, k: i64) -> Complex<f64> {
         let l = (OVERSAMPLING * self.n) as i64;
         let r = k.rem_euclid(l);
-        let v = if r as usize >= self.gridded.len() {
+        if r as usize >= self.gridded.len() {
             self.gridded[(l - r) as usize].conj()
         } else {
             self.gridded[r as usize]
-        };
-        let centre = 0.5 * (self.n - 1) as f64;
-        // The phase of the unwrapped k: e^{2πikc/L} is not L-periodic in k when c is a half.
-        v * Complex::from_polar(1.0, 2.0 * PI * k as f64 * centre / l as f64)
+        }
     }
 
-    /// Amplitude at padded bin j (frequency j·Δω/pad).
+    /// Amplitude at padded bin j (frequency j·Δω/pad): |Σ_k g(θ − hk) e^{ikhc} V_k| h, summed
+    /// over the 2W + 1 grid points from k₀ = round(θ/h) − W. The Gaussian factors as
+    /// e^{−d₀²/4τ} (e^{d₀h/2τ})^m e^{−h²m²/4τ}, d₀ = θ − hk₀, m = k − k₀ (Greengard & Lee's fast
+    /// gridding: two exponentials a value), and the centring phase e^{ikhc} (c = (n − 1)/2, of
+    /// the unwrapped k: it is not periodic in k when c is a half) advances by one rotation.
     pub fn amplitude(&self, j: usize) -> f64 {
         let l = (OVERSAMPLING * self.n) as f64;
         let h = 2.0 * PI / l;
         let theta = 2.0 * PI * j as f64 / (self.pad * self.n) as f64;
-        let nearest = (theta / h).round() as i64;
+        let k0 = (theta / h).round() as i64 - SPREAD;
+        let d0 = theta - h * k0 as f64;
+        let four_tau = 4.0 * self.tau;
+        let mut weight = (-d0 * d0 / four_tau).exp();
+        let growth = (2.0 * d0 * h / four_tau).exp();
+        let centre = 0.5 * (self.n - 1) as f64;
+        let mut phase = Complex::from_polar(1.0, h * centre * k0 as f64);
+        let rotation = Complex::from_polar(1.0, h * centre);
         let mut sum = Complex::new(0.0, 0.0);
-        for k in nearest - SPREAD..=nearest + SPREAD {
-            let d = theta - h * k as f64;
-            sum += self.gridded(k) * (-d * d / (4.0 * self.tau)).exp();
+        for (m, tail) in self.tail.iter().enumerate() {
+            sum += self.gridded(k0 + m as i64) * phase * (weight * tail);
+            weight *= growth;
+            phase *= rotation;
         }
         magnitude(sum) * h * self.scale
     }
