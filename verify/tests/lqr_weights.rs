@@ -1,0 +1,171 @@
+//! The LQR's gain follows its weights: the gain a run reports in `controller_gains` equals the
+//! gain built here from the scenario's own keys — the plant linearised from the robot's geometry
+//! (MODELS.md §11's structure matrix and the geometric stiffness of taut rigid cables at the
+//! design point) and the CARE solved by a method the controller does not use (the Hamiltonian's
+//! matrix sign function, Roberts 1971 with Byers' determinant scaling, against the controller's
+//! invariant subspace and Newton–Kleinman). Halving `q_position` in the controller's code, or
+//! scaling it by 1e-3, changed no other test's outcome; this one fails.
+
+use cdpr_bench::{assess, scenario_from_toml_str};
+use nalgebra::{DMatrix, Matrix2, Vector2};
+use proptest::prelude::*;
+
+/// X of Aᵀ X + X A − X B R⁻¹ Bᵀ X + Q = 0 by the sign of H = [A, −B R⁻¹ Bᵀ; −Q, −Aᵀ]:
+/// Z ← (Z/c + c Z⁻¹)/2, c = |det Z|^(1/2n), until Z² = I; then [W₁₂; W₂₂ + I] X = −[W₁₁ + I; W₂₁]
+/// in least squares.
+fn care_by_sign(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+) -> DMatrix<f64> {
+    let n = a.nrows();
+    let r_inv = r.clone().try_inverse().expect("R invertible");
+    let g = b * &r_inv * b.transpose();
+    let mut z = DMatrix::zeros(2 * n, 2 * n);
+    z.view_mut((0, 0), (n, n)).copy_from(a);
+    z.view_mut((0, n), (n, n)).copy_from(&(-&g));
+    z.view_mut((n, 0), (n, n)).copy_from(&(-q));
+    z.view_mut((n, n), (n, n)).copy_from(&(-a.transpose()));
+    for _ in 0..100 {
+        let inv = z
+            .clone()
+            .try_inverse()
+            .expect("H has no eigenvalue on the imaginary axis");
+        let c = z.determinant().abs().powf(1.0 / (2 * n) as f64);
+        let next = (&z / c + &inv * c) * 0.5;
+        let change = (&next - &z).norm() / next.norm();
+        z = next;
+        if change < 1e-15 {
+            break;
+        }
+    }
+    let identity = DMatrix::<f64>::identity(n, n);
+    let mut lhs = DMatrix::zeros(2 * n, n);
+    lhs.view_mut((0, 0), (n, n))
+        .copy_from(&z.view((0, n), (n, n)));
+    lhs.view_mut((n, 0), (n, n))
+        .copy_from(&(z.view((n, n), (n, n)) + &identity));
+    let mut rhs = DMatrix::zeros(2 * n, n);
+    rhs.view_mut((0, 0), (n, n))
+        .copy_from(&(-(z.view((0, 0), (n, n)) + &identity)));
+    rhs.view_mut((n, 0), (n, n))
+        .copy_from(&(-z.view((n, 0), (n, n))));
+    let x = lhs
+        .svd(true, true)
+        .solve(&rhs, 1e-14)
+        .expect("least squares");
+    (&x + x.transpose()) * 0.5
+}
+
+/// The LQR gain K (2 × 6, on (δx, δz, δẋ, δż, σx, σz)) of the paper's robot with pulleys at
+/// (0, 0) and (d, 0), an effector of mass M at the design point p on rigid massless cables under
+/// gravity g, for the weights Q = diag(qp, qp, qv, qv, qi, qi), R = r I.
+fn expected_gain(d: f64, m: f64, g: f64, p: Vector2<f64>, weights: [f64; 4]) -> DMatrix<f64> {
+    let anchors = [Vector2::new(0.0, 0.0), Vector2::new(d, 0.0)];
+    let (l, u): (Vec<f64>, Vec<Vector2<f64>>) = anchors
+        .iter()
+        .map(|a| {
+            let to_anchor = a - p;
+            (to_anchor.norm(), to_anchor / to_anchor.norm())
+        })
+        .unzip();
+    let w = Matrix2::from_columns(&[u[0], u[1]]);
+    let hold = w.try_inverse().unwrap() * Vector2::new(0.0, m * g);
+    let stiffness: Matrix2<f64> = (0..2)
+        .map(|i| -hold[i] * (Matrix2::identity() - u[i] * u[i].transpose()) / l[i])
+        .sum();
+    let mut a = DMatrix::zeros(6, 6);
+    let mut b = DMatrix::zeros(6, 2);
+    for i in 0..2 {
+        a[(i, 2 + i)] = 1.0;
+        a[(4 + i, i)] = 1.0;
+        for j in 0..2 {
+            a[(2 + i, j)] = stiffness[(i, j)] / m;
+            b[(2 + i, j)] = w[(i, j)] / m;
+        }
+    }
+    let [qp, qv, qi, r] = weights;
+    let q = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![qp, qp, qv, qv, qi, qi]));
+    let r = DMatrix::identity(2, 2) * r;
+    let x = care_by_sign(&a, &b, &q, &r);
+    r.try_inverse().unwrap() * b.transpose() * x
+}
+
+/// The solver of this test against closed forms: ẋ = u (X = √(qr)) and the double integrator
+/// ẍ = u with Q = diag(q₁, q₂), whose gain is [√(q₁/r), √(q₂/r + 2√(q₁/r))].
+#[test]
+fn the_sign_function_solver_meets_the_closed_forms() {
+    let one = |v: f64| DMatrix::from_element(1, 1, v);
+    let x = care_by_sign(&one(0.0), &one(1.0), &one(4.0), &one(9.0));
+    assert!((x[(0, 0)] - 6.0).abs() < 1e-12, "{x}");
+    for (q1, q2, r) in [(1.0, 1.0, 1.0), (1e9, 1e4, 1.0), (3.0, 0.0, 0.5)] {
+        let a = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, 0.0, 0.0]);
+        let b = DMatrix::from_row_slice(2, 1, &[0.0, 1.0]);
+        let q = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![q1, q2]));
+        let x = care_by_sign(&a, &b, &q, &one(r));
+        let k = b.transpose() * x / r;
+        let expected = [(q1 / r).sqrt(), (q2 / r + 2.0 * (q1 / r).sqrt()).sqrt()];
+        for j in 0..2 {
+            assert!(
+                (k[(0, j)] - expected[j]).abs() <= 1e-9 * expected[j],
+                "q = ({q1}, {q2}), r = {r}: {k} vs {expected:?}"
+            );
+        }
+    }
+}
+
+/// The gain a run reports for the scenario's weights, against the gain built from those keys.
+/// Tolerance 1e-7 of the gain's norm: both solvers end at round-off of a CARE whose weights span
+/// up to 1e12 (the sign iteration's conditioning, ~1e-9 here, dominates).
+fn check(weights: [f64; 4], x2: f64) -> Result<(), TestCaseError> {
+    let [qp, qv, qi, r] = weights;
+    let scenario = scenario_from_toml_str(&format!(
+        "[controller]\nkind = \"lqr\"\nq_position = {qp:e}\nq_velocity = {qv:e}\n\
+         q_integral = {qi:e}\nr = {r:e}\n[trajectory]\nx2 = {x2}\n\
+         [simulation]\nt_final = 0.01\nsample_period = 1e-3\n[analysis]\nmodes = \"off\"\n"
+    ))
+    .unwrap();
+    let run = assess(&scenario, &mut |_| {}).unwrap();
+    let gains = &run.metrics.control.controller_gains;
+    let reported = DMatrix::from_row_slice(2, 6, &gains["lqr_gain"]);
+    // The design point: the move's end at the start's height (the run's first sample).
+    let p = Vector2::new(x2, run.metrics.z0);
+    prop_assert_eq!(&gains["lqr_design_point"], &vec![p.x, p.y]);
+    let robot = &scenario.robot;
+    let expected = expected_gain(
+        robot.anchor_distance,
+        robot.effector_mass,
+        robot.gravity,
+        p,
+        weights,
+    );
+    let error = (&reported - &expected).norm() / expected.norm();
+    prop_assert!(
+        error < 1e-7,
+        "weights {:?}: reported\n{}\nexpected\n{}\nrelative error {:e}",
+        weights,
+        reported,
+        expected,
+        error
+    );
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    /// Over four decades of each weight around the defaults (1e9, 1e4, 1e10, 1), at the move's
+    /// end of the paper (x2 = 0.6 m, where x and z couple) and at the middle (x and z decouple).
+    #[test]
+    fn the_reported_gain_follows_the_scenario_weights(
+        qp in 7.0..11.0f64,
+        qv in 2.0..6.0f64,
+        qi in 8.0..12.0f64,
+        r in -1.0..1.0f64,
+        middle in any::<bool>(),
+    ) {
+        let weights = [10f64.powf(qp), 10f64.powf(qv), 10f64.powf(qi), 10f64.powf(r)];
+        check(weights, if middle { 0.5 } else { 0.6 })?;
+    }
+}
