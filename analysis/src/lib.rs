@@ -25,6 +25,9 @@ pub enum AnalysisError {
     /// The model refused the state or found no equilibrium.
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// The closed loop could not be built or brought to rest.
+    #[error(transparent)]
+    Loop(#[from] cdpr_core::closed_loop::LoopError),
     #[error("eigenvalue computation failed: {0:?}")]
     Eigen(EvdError),
     #[error(transparent)]

@@ -14,10 +14,10 @@
 
 use crate::AnalysisError;
 use crate::modes::{Analysis, ClassifiedMode, Loop, classify};
-use cdpr_core::Vector2;
 use cdpr_core::closed_loop::{Actuation, ClosedLoop};
 use cdpr_core::controller::Controller;
 use cdpr_core::model::{CableModel, Equilibrium};
+use cdpr_core::robot::height;
 use cdpr_core::scenario::Scenario;
 use cdpr_core::shaper::Impulses;
 use cdpr_core::trajectory::Step5;
@@ -27,7 +27,11 @@ use faer::Mat;
 
 /// Jacobian ∂y'/∂y of the closed loop (model and PID states; the audit states are left out) at
 /// (t, y) by central differences ([`jacobian`] for the step rule).
-pub fn closed_loop_jacobian<M: CableModel>(sys: &mut ClosedLoop<M>, t: f64, y: &[f64]) -> Mat<f64> {
+pub fn closed_loop_jacobian<M: CableModel<D>, const D: usize>(
+    sys: &mut ClosedLoop<M, D>,
+    t: f64,
+    y: &[f64],
+) -> Mat<f64> {
     let n = sys.dynamic_len();
     jacobian(sys, t, y, n)
 }
@@ -44,13 +48,13 @@ pub struct Linearised {
 
 /// Modal analysis of `model` in the scenario's closed loop at effector position `x` [m]: the
 /// static equilibrium of MODELS.md §2 there, with the reference held at x.
-pub fn linearise<M: CableModel>(
+pub fn linearise<M: CableModel<D>, const D: usize>(
     model: M,
     scenario: &Scenario,
     x: f64,
     feedback: Loop,
 ) -> Result<Linearised, AnalysisError> {
-    let mut sys = ClosedLoop::new(model, scenario);
+    let mut sys = ClosedLoop::new(model, scenario)?;
     check_size(sys.dynamic_len())?;
     if sys.controller.kind().acts_on_z() {
         // The held height z0 is the start equilibrium's.
@@ -120,8 +124,8 @@ pub fn linearise<M: CableModel>(
     Ok(Linearised {
         analysis: Analysis {
             model: sys.model.name(),
-            x: p.x,
-            z: p.y,
+            x: p[0],
+            z: height(&p),
             feedback,
             tensions,
             modes,
@@ -155,14 +159,21 @@ pub struct EndState {
     pub mode: Mode,
     /// Static equilibrium at x2 (MODELS.md §2 rule).
     pub equilibrium: Equilibrium,
-    /// Effector position there [m].
-    pub effector: Vector2<f64>,
+    /// Effector position there [m], per axis, the vertical last.
+    pub effector: Vec<f64>,
+}
+
+impl EndState {
+    /// The effector's height there [m].
+    pub fn effector_height(&self) -> f64 {
+        self.effector.last().copied().unwrap_or(f64::NAN)
+    }
 }
 
 /// [`EndState`] of `sys` at the trajectory's x2: the closed-loop mode nearest `omega_guess`
 /// [rad/s], from the finite-difference Jacobian of model + controller.
-pub fn end_state<M: CableModel>(
-    mut sys: ClosedLoop<M>,
+pub fn end_state<M: CableModel<D>, const D: usize>(
+    mut sys: ClosedLoop<M, D>,
     omega_guess: f64,
 ) -> Result<EndState, AnalysisError> {
     check_size(sys.dynamic_len())?;
@@ -174,7 +185,7 @@ pub fn end_state<M: CableModel>(
     let jac = closed_loop_jacobian(&mut sys, t, &y);
     let modes = modes(&jac).map_err(AnalysisError::Eigen)?;
     let mode = nearest_mode(&modes, omega_guess).ok_or(AnalysisError::NoMode)?;
-    let effector = sys.model.effector(&eq.state).position;
+    let effector = sys.model.effector(&eq.state).position.as_slice().to_vec();
     Ok(EndState {
         mode,
         equilibrium: eq,

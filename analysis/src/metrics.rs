@@ -472,7 +472,7 @@ impl Metrics {
             err_hf_peak_db,
             err_hf_peaks,
             z0: z.first().copied().unwrap_or(f64::NAN),
-            f0: run.equilibrium.force,
+            f0: run.equilibrium.force(),
             energy_residual_max: max_abs(c.e_residual),
             pulley_events: run.events.len(),
             pulley_energy_loss: -run.events.iter().map(|e| e.energy_change).sum::<f64>(),

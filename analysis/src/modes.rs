@@ -4,6 +4,7 @@
 //! what its coordinates are ([`cdpr_core::modal_layout::ModalLayout`]); this module knows no model.
 
 use cdpr_core::modal_layout::{Dof, ModalLayout};
+use cdpr_core::robot::Tensions;
 use cdpr_numerics::eigen::Mode;
 
 /// What a mode is, by the largest share of its mass-weighted displacement.
@@ -59,8 +60,8 @@ pub struct Analysis {
     /// Effector z [m] there.
     pub z: f64,
     pub feedback: Loop,
-    /// Commanded tensions at the equilibrium [N].
-    pub tensions: [f64; 2],
+    /// Commanded tensions at the equilibrium [N], one per cable.
+    pub tensions: Tensions,
     /// Modes sorted by frequency (one of each conjugate pair; real modes have ω = 0).
     pub modes: Vec<ClassifiedMode>,
 }
@@ -93,27 +94,38 @@ impl Analysis {
 /// cable tangent → axial, across → transverse; an axial coordinate → axial.
 pub fn classify(layout: &ModalLayout, u: &[(f64, f64)]) -> (ModeKind, f64) {
     let abs2 = |(re, im): (f64, f64)| re * re + im * im;
-    // [vertical, horizontal, transverse 1, transverse 2, axial 1, axial 2]
-    let mut share = [0.0f64; 6];
+    let cables = layout
+        .dofs
+        .iter()
+        .filter_map(|dof| match dof {
+            Dof::Node { cable, .. } | Dof::Axial { cable, .. } => Some(cable + 1),
+            Dof::Effector { .. } => None,
+        })
+        .max()
+        .unwrap_or(0);
+    // [vertical, horizontal, transverse per cable…, axial per cable…]
+    let mut share = vec![0.0f64; 2 + 2 * cables];
+    let (transverse, axial) = (2, 2 + cables);
     for dof in &layout.dofs {
-        match *dof {
-            Dof::Effector { x, z, mass } => {
-                share[1] += mass * abs2(u[x]);
-                share[0] += mass * abs2(u[z]);
+        match dof {
+            Dof::Effector { coordinates, mass } => {
+                let (vertical, horizontal) = coordinates.split_last().expect("one axis at least");
+                for &k in horizontal {
+                    share[1] += mass * abs2(u[k]);
+                }
+                share[0] += mass * abs2(u[*vertical]);
             }
             Dof::Node {
                 cable,
-                x,
-                z,
-                tangent: t,
+                coordinates,
+                tangent,
                 mass,
             } => {
-                let along = (t.x * u[x].0 + t.y * u[z].0, t.x * u[x].1 + t.y * u[z].1);
-                let across = (-t.y * u[x].0 + t.x * u[z].0, -t.y * u[x].1 + t.x * u[z].1);
-                share[4 + cable] += mass * abs2(along);
-                share[2 + cable] += mass * abs2(across);
+                let (along, across) = split_along(coordinates, tangent, u);
+                share[axial + cable] += mass * along;
+                share[transverse + cable] += mass * across;
             }
-            Dof::Axial { cable, index, mass } => share[4 + cable] += mass * abs2(u[index]),
+            Dof::Axial { cable, index, mass } => share[axial + cable] += mass * abs2(u[*index]),
         }
     }
     let total: f64 = share.iter().sum();
@@ -121,18 +133,41 @@ pub fn classify(layout: &ModalLayout, u: &[(f64, f64)]) -> (ModeKind, f64) {
         .iter()
         .enumerate()
         .max_by(|a, b| a.1.total_cmp(b.1))
-        .expect("six shares");
+        .expect("two shares at least");
     let kind = match best {
         0 => ModeKind::Vertical,
         1 => ModeKind::Horizontal,
-        2 | 3 => ModeKind::Transverse(best - 2),
-        _ => ModeKind::Axial(best - 4),
+        k if k < axial => ModeKind::Transverse(k - transverse),
+        k => ModeKind::Axial(k - axial),
     };
     // No displacement at all (a pure controller-state mode): the controller's x loop.
     if total == 0.0 {
         return (ModeKind::Horizontal, 1.0);
     }
     (kind, value / total)
+}
+
+/// |u·t|² and |u − (u·t)t|² of a node's complex displacement `u` against its unit `tangent`.
+/// In the plane the transverse part is the rotated projection (−t_z, t_x)·u, as MODELS.md states it.
+fn split_along(coordinates: &[usize], tangent: &[f64], u: &[(f64, f64)]) -> (f64, f64) {
+    let abs2 = |(re, im): (f64, f64)| re * re + im * im;
+    let dot = |w: &[f64]| {
+        coordinates
+            .iter()
+            .zip(w)
+            .fold((0.0, 0.0), |(re, im), (&k, &c)| {
+                (re + c * u[k].0, im + c * u[k].1)
+            })
+    };
+    if let [tx, tz] = *tangent {
+        let (x, z) = (u[coordinates[0]], u[coordinates[1]]);
+        let along = (tx * x.0 + tz * z.0, tx * x.1 + tz * z.1);
+        let across = (-tz * x.0 + tx * z.0, -tz * x.1 + tx * z.1);
+        return (abs2(along), abs2(across));
+    }
+    let along = dot(tangent);
+    let total: f64 = coordinates.iter().map(|&k| abs2(u[k])).sum();
+    (abs2(along), (total - abs2(along)).max(0.0))
 }
 
 /// Taut-string transverse frequency ω_k = (kπ/l)√(T/μ_s) [rad/s] of a span of chord `length` l

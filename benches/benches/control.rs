@@ -31,7 +31,7 @@ fn rhs(c: &mut Criterion) {
     let mut group = c.benchmark_group("control_rhs");
     for kind in ControllerKind::ALL {
         let s = benchmark(kind, ModelKind::Elastic);
-        let mut sys = ClosedLoop::new(Elastic::new(&s), &s);
+        let mut sys = ClosedLoop::new(Elastic::from_scenario(&s), &s).unwrap();
         let (y, _) = sys.initial_state().unwrap();
         let mut dy = vec![0.0; y.len()];
         group.bench_function(kind.name(), |b| {
@@ -56,7 +56,7 @@ fn implicit_runs(c: &mut Criterion) {
             let mut buffer = SeriesBuffer::default();
             group.bench_function(format!("{}_{}_5s", kind.name(), model.name()), |b| {
                 b.iter(|| {
-                    let mut sys = ClosedLoop::new(build(&s).unwrap(), &s);
+                    let mut sys = ClosedLoop::new(build(&s).unwrap(), &s).unwrap();
                     let run =
                         simulate_reusing(&mut sys, &opts, std::mem::take(&mut buffer), &mut |_| {})
                             .unwrap();

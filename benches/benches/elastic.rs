@@ -12,7 +12,7 @@ use std::hint::black_box;
 
 fn rhs(c: &mut Criterion) {
     let scenario = Scenario::paper();
-    let mut sys = ClosedLoop::new(Elastic::new(&scenario), &scenario);
+    let mut sys = ClosedLoop::new(Elastic::from_scenario(&scenario), &scenario).unwrap();
     let (y, _) = sys.initial_state().unwrap();
     let mut dy = vec![0.0; y.len()];
     c.bench_function("elastic/rhs", |b| {
@@ -34,7 +34,7 @@ fn paper_run(c: &mut Criterion) {
     let opts = RunOptions::from(&scenario);
     group.bench_function("sampled_1e-5_fresh_memory", |b| {
         b.iter(|| {
-            let mut sys = ClosedLoop::new(Elastic::new(&scenario), &scenario);
+            let mut sys = ClosedLoop::new(Elastic::from_scenario(&scenario), &scenario).unwrap();
             let run = simulate(&mut sys, &opts, &mut |_| {}).unwrap();
             black_box(run.series.len())
         })
@@ -42,7 +42,7 @@ fn paper_run(c: &mut Criterion) {
     let mut buffer = SeriesBuffer::default();
     group.bench_function("sampled_1e-5_reused_memory", |b| {
         b.iter(|| {
-            let mut sys = ClosedLoop::new(Elastic::new(&scenario), &scenario);
+            let mut sys = ClosedLoop::new(Elastic::from_scenario(&scenario), &scenario).unwrap();
             let run = simulate_reusing(&mut sys, &opts, std::mem::take(&mut buffer), &mut |_| {})
                 .unwrap();
             let n = run.series.len();
@@ -55,7 +55,7 @@ fn paper_run(c: &mut Criterion) {
     let opts = RunOptions::from(&ends_only);
     group.bench_function("integration_only", |b| {
         b.iter(|| {
-            let mut sys = ClosedLoop::new(Elastic::new(&ends_only), &ends_only);
+            let mut sys = ClosedLoop::new(Elastic::from_scenario(&ends_only), &ends_only).unwrap();
             let run = simulate(&mut sys, &opts, &mut |_| {}).unwrap();
             black_box(run.series.len())
         })

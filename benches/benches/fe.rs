@@ -13,7 +13,8 @@ use std::time::Duration;
 
 fn rhs(c: &mut Criterion) {
     let scenario = Scenario::paper();
-    let mut sys = ClosedLoop::new(Fe::new(&scenario, Params::default()).unwrap(), &scenario);
+    let mut sys =
+        ClosedLoop::new(Fe::new(&scenario, Params::default()).unwrap(), &scenario).unwrap();
     let (mut y, _) = sys.initial_state().unwrap();
     // Moving cable: every velocity term of the assembly is exercised.
     let np = sys.model.positions_len();
@@ -54,7 +55,7 @@ fn paper_run(c: &mut Criterion) {
     group.bench_function("paper_run_5s", |b| {
         b.iter(|| {
             let mut sys =
-                ClosedLoop::new(Fe::new(&scenario, Params::default()).unwrap(), &scenario);
+                ClosedLoop::new(Fe::new(&scenario, Params::default()).unwrap(), &scenario).unwrap();
             let run = simulate(&mut sys, &opts, &mut |_| {}).unwrap();
             black_box(run.stats.rhs_evals)
         })

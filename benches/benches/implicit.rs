@@ -47,7 +47,7 @@ fn paper_runs(c: &mut Criterion) {
             group.bench_function(format!("{kind}_paper_run_5s{label}"), |b| {
                 b.iter(|| {
                     let model = build(&s).unwrap();
-                    let mut sys = ClosedLoop::new(model, &s);
+                    let mut sys = ClosedLoop::new(model, &s).unwrap();
                     let run =
                         simulate_reusing(&mut sys, &opts, std::mem::take(&mut buffer), &mut |_| {})
                             .unwrap();
@@ -64,7 +64,7 @@ fn paper_runs(c: &mut Criterion) {
 /// 0.02 s of the paper's run from the static equilibrium at x_ref(0) (solved once, outside the
 /// timing), with a fresh copy of the model per iteration (the lumped model's stored counts change
 /// at pulley events).
-fn bench_from<M: CableModel + Clone>(
+fn bench_from<M: CableModel<2> + Clone>(
     group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     s: &Scenario,
     kind: ModelKind,
@@ -72,7 +72,7 @@ fn bench_from<M: CableModel + Clone>(
     model: M,
 ) {
     let opts = RunOptions::from(s);
-    let mut sys = ClosedLoop::new(model, s);
+    let mut sys = ClosedLoop::new(model, s).unwrap();
     let (y0, eq) = sys.initial_state().unwrap();
     let start = sys.model.clone();
     if std::env::var_os("CDPR_BENCH_STATS").is_some() {
@@ -103,7 +103,7 @@ struct BenchFrom<'a, 'g> {
 
 impl ModelVisitor for BenchFrom<'_, '_> {
     type Output = ();
-    fn visit<M: CableModel + Clone + Send + 'static>(self, model: M) {
+    fn visit<M: CableModel<2> + Clone + Send + 'static>(self, model: M) {
         bench_from(self.group, self.s, self.kind, self.n, model)
     }
 }

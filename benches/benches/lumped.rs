@@ -15,7 +15,8 @@ fn rhs(c: &mut Criterion) {
     let mut sys = ClosedLoop::new(
         Lumped::new(&scenario, Params::default()).unwrap(),
         &scenario,
-    );
+    )
+    .unwrap();
     let (y, _) = sys.initial_state().unwrap();
     let mut dy = vec![0.0; y.len()];
     c.bench_function("lumped/rhs", |b| {
@@ -38,7 +39,8 @@ fn paper_run(c: &mut Criterion) {
             let mut sys = ClosedLoop::new(
                 Lumped::new(&scenario, Params::default()).unwrap(),
                 &scenario,
-            );
+            )
+            .unwrap();
             let run = simulate(&mut sys, &opts, &mut |_| {}).unwrap();
             black_box(run.stats.rhs_evals)
         })

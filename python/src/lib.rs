@@ -77,6 +77,7 @@ fn error(e: Error) -> PyErr {
     match e {
         Error::Scenario(e) => ScenarioError::new_err(e.to_string()),
         Error::Model(e) => ScenarioError::new_err(e.to_string()),
+        Error::Loop(e) => ScenarioError::new_err(e.to_string()),
         Error::Run(failure) => SimulationError::new_err(failure.to_string()),
         Error::Analysis(e) => SimulationError::new_err(e.to_string()),
     }

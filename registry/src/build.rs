@@ -21,7 +21,7 @@ pub enum BuildError {
 /// Generic work on a model of any kind (see [`with_model`]).
 pub trait ModelVisitor {
     type Output;
-    fn visit<M: CableModel + Clone + Send + 'static>(self, model: M) -> Self::Output;
+    fn visit<M: CableModel<2> + Clone + Send + 'static>(self, model: M) -> Self::Output;
 }
 
 /// Generic work on the chosen model's parameters.
@@ -57,7 +57,7 @@ fn with_params<V: ParamsVisitor>(
 /// struct StateLen;
 /// impl ModelVisitor for StateLen {
 ///     type Output = usize;
-///     fn visit<M: CableModel + Clone + Send + 'static>(self, model: M) -> usize {
+///     fn visit<M: CableModel<2> + Clone + Send + 'static>(self, model: M) -> usize {
 ///         model.state_len()
 ///     }
 /// }
@@ -107,7 +107,7 @@ pub(crate) fn resolved_section(config: &ModelConfig) -> Result<serde_json::Value
 }
 
 /// A cable model, whichever the scenario names: what the closed loop runs.
-pub type DynModel = Box<dyn CableModel + Send>;
+pub type DynModel = Box<dyn CableModel<2> + Send>;
 
 /// The scenario's cable model.
 ///
@@ -126,7 +126,7 @@ pub fn build(scenario: &Scenario) -> Result<DynModel, BuildError> {
     struct Boxed;
     impl ModelVisitor for Boxed {
         type Output = DynModel;
-        fn visit<M: CableModel + Clone + Send + 'static>(self, model: M) -> DynModel {
+        fn visit<M: CableModel<2> + Clone + Send + 'static>(self, model: M) -> DynModel {
             Box::new(model)
         }
     }

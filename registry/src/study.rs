@@ -12,6 +12,7 @@ use cdpr_analysis::linearise::{self, EndState, Linearised};
 use cdpr_analysis::metrics::Metrics;
 use cdpr_analysis::modes::{Analysis, ClassifiedMode, Loop, ModeKind};
 use cdpr_core::closed_loop::ClosedLoop;
+use cdpr_core::closed_loop::LoopError;
 use cdpr_core::controller::TensionLimits;
 use cdpr_core::model::{CableModel, ModelError};
 use cdpr_core::runner::{
@@ -31,6 +32,8 @@ pub enum Error {
     Scenario(#[from] ScenarioError),
     #[error(transparent)]
     Model(#[from] ModelError),
+    #[error(transparent)]
+    Loop(#[from] LoopError),
     #[error(transparent)]
     Run(#[from] Box<RunFailure>),
     #[error(transparent)]
@@ -60,7 +63,7 @@ pub fn simulate_observed_into(
     buffer: SeriesBuffer,
 ) -> Result<Run, Error> {
     let scenario = &resolve_shaper(scenario)?;
-    let mut sys = ClosedLoop::new(build(scenario)?, scenario);
+    let mut sys = ClosedLoop::new(build(scenario)?, scenario)?;
     Ok(simulate_run(
         &mut sys,
         &RunOptions::from(scenario),
@@ -362,17 +365,17 @@ pub fn resolve_shaper(scenario: &Scenario) -> Result<Scenario, Error> {
 pub fn prepare(scenario: &Scenario) -> Result<Scenario, Error> {
     let resolved = resolve_shaper(scenario)?;
     let config = ModelConfig::from_scenario(&resolved)?;
-    let mut sys = ClosedLoop::new(build(&resolved)?, &resolved);
-    sys.initial_state()
-        .map_err(|e| start_error(&resolved, &config, e))?;
+    let start = |e| start_error(&resolved, &config, e);
+    let mut sys = ClosedLoop::new(build(&resolved)?, &resolved).map_err(start)?;
+    sys.initial_state().map_err(start)?;
     Ok(resolved)
 }
 
 /// The keys that set a start that failed, and why.
-fn start_error(scenario: &Scenario, config: &ModelConfig, error: ModelError) -> ScenarioError {
+fn start_error(scenario: &Scenario, config: &ModelConfig, error: LoopError) -> ScenarioError {
     let c = &scenario.controller;
     let keys = match &error {
-        ModelError::Control(_) => format!(
+        LoopError::Control(_) | LoopError::ControllerStates { .. } => format!(
             "controller.kind = \"{}\", q_position = {}, q_velocity = {}, q_integral = {}, r = {}",
             c.kind.name(),
             c.q_position,
@@ -393,7 +396,7 @@ fn start_error(scenario: &Scenario, config: &ModelConfig, error: ModelError) -> 
         }
     };
     let why = match error {
-        ModelError::Control(e) => format!("the controller cannot be designed at the start: {e}"),
+        LoopError::Control(e) => format!("the controller cannot be designed at the start: {e}"),
         e => format!("the run cannot start: {e}"),
     };
     ScenarioError::Infeasible { keys, why }
@@ -402,7 +405,7 @@ fn start_error(scenario: &Scenario, config: &ModelConfig, error: ModelError) -> 
 /// The static equilibrium at x2 and the closed-loop mode nearest eq. 15 there (the effector's
 /// vertical mode), from the finite-difference Jacobian of model + PID + tension distribution.
 pub fn end_state(scenario: &Scenario) -> Result<EndState, Error> {
-    let sys = ClosedLoop::new(build(scenario)?, scenario);
+    let sys = ClosedLoop::new(build(scenario)?, scenario)?;
     Ok(linearise::end_state(sys, eq15_at_end(scenario))?)
 }
 
@@ -442,7 +445,7 @@ pub fn linearise(scenario: &Scenario, x: f64, feedback: Loop) -> Result<Linearis
     struct Linearise<'a>(&'a Scenario, f64, Loop);
     impl ModelVisitor for Linearise<'_> {
         type Output = Result<Linearised, AnalysisError>;
-        fn visit<M: CableModel + Clone + Send + 'static>(self, model: M) -> Self::Output {
+        fn visit<M: CableModel<2> + Clone + Send + 'static>(self, model: M) -> Self::Output {
             linearise::linearise(model, self.0, self.1, self.2)
         }
     }

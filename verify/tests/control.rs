@@ -10,8 +10,9 @@ use cdpr_bench::core::channel::Channel;
 use cdpr_bench::core::closed_loop::ClosedLoop;
 use cdpr_bench::core::controller::lqr::Lqr;
 use cdpr_bench::core::controller::velocity_filter::VelocityFilter;
-use cdpr_bench::core::controller::{self, Controller, Plant, Reference, StepStart, TensionLimits};
-use cdpr_bench::core::model::{CableModel, Effector};
+use cdpr_bench::core::controller::{self, Controller, Reference, StepStart, TensionLimits};
+use cdpr_bench::core::model::CableModel;
+use cdpr_bench::core::robot::{Effector, Tensions};
 use cdpr_bench::core::runner::{RunOptions, simulate_from};
 use cdpr_bench::core::scenario::{ControllerKind, Scenario};
 use cdpr_bench::elastic::Elastic;
@@ -39,7 +40,7 @@ fn computed_torque_gives_the_designed_error_dynamics_on_the_elastic_model() {
         3.0 * omega,
         omega.powi(3)
     ));
-    let mut sys = ClosedLoop::new(Elastic::new(&s), &s);
+    let mut sys = ClosedLoop::new(Elastic::from_scenario(&s), &s).unwrap();
     let (mut y0, eq) = sys.initial_state().unwrap();
     let (dx, dz) = (1e-3, -5e-4);
     y0[0] += dx;
@@ -99,7 +100,7 @@ fn computed_torque_and_lqr_track_the_move_exactly_on_the_elastic_model() {
                 .unwrap()
                 .1;
             assert_eq!(point[0], s.trajectory.x2);
-            let designed = Lqr::new(&s, Plant::new(&s)).designed_at(point[1]).unwrap();
+            let designed = Lqr::new(&s, s.robot()).designed_at(point[1]).unwrap();
             assert_eq!(*gains, designed.gains(), "the run reports its design");
             assert!(gains.iter().any(|(k, v)| *k == "lqr_gain" && v.len() == 12));
         }
@@ -137,16 +138,16 @@ fn central(f: impl Fn(f64) -> Vec<f64>, h: f64) -> Vec<f64> {
 #[test]
 fn lqr_design_matches_the_elastic_linearisation_and_the_riccati_equation() {
     let s = scenario("[controller]\nkind = \"lqr\"\n");
-    let plant = Plant::new(&s);
-    let model = Elastic::new(&s);
+    let robot = s.robot();
+    let model = Elastic::from_scenario(&s);
     for z0 in [-0.0247, -0.05, -0.1] {
-        let lqr = Lqr::new(&s, plant).designed_at(z0).unwrap();
+        let lqr = Lqr::new(&s, robot).designed_at(z0).unwrap();
         let (a, b) = lqr.linearisation();
         let p = Vector2::new(s.trajectory.x2, z0);
-        let hold = plant.tensions_for_acceleration(p, Vector2::zeros());
-        let rate = |model: &mut Elastic, y: [f64; 4], t: [f64; 2]| {
+        let hold = controller::tensions_for_acceleration(&robot, &p, &Vector2::zeros());
+        let rate = |model: &mut Elastic<2>, y: [f64; 4], t: Tensions| {
             let mut r = vec![0.0; 4];
-            model.rhs(0.0, &y, t, &mut r);
+            model.rhs(0.0, &y, &t, &mut r);
             r
         };
         let y = [p.x, p.y, 0.0, 0.0];
@@ -189,7 +190,7 @@ fn lqr_design_matches_the_elastic_linearisation_and_the_riccati_equation() {
         // The closed loop A − B K of the design.
         let k = &lqr.gain;
         let closed = Mat::from_fn(6, 6, |i, j| {
-            a[i * 6 + j] - (0..2).map(|m| b[i * 2 + m] * k[(m, j)]).sum::<f64>()
+            a[i * 6 + j] - (0..2).map(|m| b[i * 2 + m] * k[m * 6 + j]).sum::<f64>()
         });
         let eig = closed.eigenvalues().unwrap();
         assert!(eig.iter().all(|l| l.re < 0.0), "A − BK stable: {eig:?}");
@@ -286,7 +287,10 @@ fn saturation_holds_the_limits_and_anti_windup_lets_the_loop_settle() {
     );
     // While saturated the integrals' rates are zero and the implicit step holds them.
     let limits = TensionLimits::from(&s.controller);
-    assert_eq!(limits.clamp([80.0, 100.0]), ([90.0, 100.0], true));
+    assert_eq!(
+        limits.clamp(&Tensions::pair([80.0, 100.0])),
+        (Tensions::pair([90.0, 100.0]), true)
+    );
     for kind in [
         ControllerKind::PidXz,
         ControllerKind::ComputedTorque,
@@ -294,7 +298,7 @@ fn saturation_holds_the_limits_and_anti_windup_lets_the_loop_settle() {
     ] {
         let mut sc = s.clone();
         sc.controller.kind = kind;
-        let mut ctl = controller::build(&sc);
+        let mut ctl = controller::build(&sc, sc.robot());
         ctl.hold_height(-0.025).unwrap();
         let states = vec![0.3; ctl.state_len()];
         let reference = Reference {
@@ -347,10 +351,10 @@ proptest! {
     ) {
         let filter = VelocityFilter { omega };
         let mut s1 = [0.0; 4];
-        filter.trapezoidal_step(&s0, u0, u1, h, &mut s1);
+        filter.trapezoidal_step(&s0, &u0, &u1, h, &mut s1);
         let (mut f0, mut f1) = ([0.0; 4], [0.0; 4]);
-        filter.rate(&s0, u0, &mut f0);
-        filter.rate(&s1, u1, &mut f1);
+        filter.rate(&s0, &u0, &mut f0);
+        filter.rate(&s1, &u1, &mut f1);
         let scale = 1.0 + omega * omega * h;
         for k in 0..4 {
             let defect = s1[k] - s0[k] - 0.5 * h * (f0[k] + f1[k]);
@@ -378,7 +382,7 @@ fn closed_loop_iteration_matrices_match_differences_for_every_controller() {
                 "[model]\nkind = \"{model}\"\n[controller]\nkind = \"{kind}\"\n\
                  [simulation]\nintegrator = \"implicit\"\n"
             ));
-            let mut sys = ClosedLoop::new(cdpr_bench::build(&s).unwrap(), &s);
+            let mut sys = ClosedLoop::new(cdpr_bench::build(&s).unwrap(), &s).unwrap();
             let (mut y, _) = sys.initial_state().unwrap();
             let n = sys.dofs();
             for i in 0..n {
@@ -421,7 +425,7 @@ fn closed_loop_iteration_matrices_match_differences_for_every_controller() {
             let scale = fd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             let form = sys.model.second_order().unwrap();
             let rows = form.tension_rows();
-            let effector = [form.effector_x(), form.effector_z()];
+            let effector = [form.effector_coordinate(0), form.effector_coordinate(1)];
             let mut checked = 0;
             for row in 0..n {
                 for col in 0..n {

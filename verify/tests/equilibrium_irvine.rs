@@ -8,9 +8,10 @@
 //! position error of δ costs EA/L δ of force the other way: 3e5 N/m here).
 
 use cdpr_bench::core::Vector2;
-use cdpr_bench::core::channel::{Cable, Channel};
+use cdpr_bench::core::channel::Channel;
 use cdpr_bench::core::controller::split_tensions;
-use cdpr_bench::core::model::CableModel;
+use cdpr_bench::core::model::{CableModel, SplitRule};
+use cdpr_bench::core::robot::CableId;
 use cdpr_bench::core::scenario::Scenario;
 use cdpr_bench::{ModelConfig, ModelKind, build};
 use cdpr_verify::irvine::Catenary;
@@ -45,17 +46,17 @@ fn mismatch(c: Case) -> (f64, f64, f64) {
     s.robot.effector_mass = c.mass;
     s.controller.tension_sum = c.tension_sum;
     let mut m = build(&s).unwrap();
-    let eq = m.equilibrium(c.x, c.tension_sum).unwrap();
+    let eq = m.equilibrium(&SplitRule::new(c.x, c.tension_sum)).unwrap();
     let p = m.effector(&eq.state).position;
     let names = m.channel_names();
     let mut values = vec![0.0; names.len()];
-    let commanded = split_tensions(c.tension_sum, eq.force);
-    m.channels(&eq.state, commanded, &mut values);
-    let free = |cable: Cable| {
-        let name = Channel::LFree(cable).name();
-        values[names.iter().position(|n| n == name).unwrap()]
+    let commanded = split_tensions(c.tension_sum, eq.force());
+    m.channels(&eq.state, &commanded, &mut values);
+    let free = |cable: usize| {
+        let name = Channel::LFree(CableId(cable)).name();
+        values[names.iter().position(|n| *n == name).unwrap()]
     };
-    let (l1, l2) = (free(Cable::One), free(Cable::Two));
+    let (l1, l2) = (free(0), free(1));
     let (w, ea) = (
         s.cable.mass_per_length() * s.robot.gravity,
         s.cable.axial_stiffness(),

@@ -6,7 +6,7 @@
 
 use cdpr_bench::ModelKind;
 use cdpr_bench::core::channel::Channel;
-use cdpr_bench::core::model::CableModel;
+use cdpr_bench::core::model::{CableModel, SplitRule};
 use cdpr_bench::core::scenario::{IntegratorKind, Scenario};
 use cdpr_bench::fe::FeStored;
 use cdpr_bench::numerics::AlphaCoefficients;
@@ -51,7 +51,9 @@ fn check_iteration_matrix(
     }
     .into();
     let mut m = model(&scenario).unwrap();
-    let eq = m.equilibrium(x, scenario.controller.tension_sum).unwrap();
+    let eq = m
+        .equilibrium(&SplitRule::new(x, scenario.controller.tension_sum))
+        .unwrap();
     let form = m.second_order_mut().unwrap();
     let n = form.dofs();
     let mut state = eq.state.clone();
@@ -63,7 +65,7 @@ fn check_iteration_matrix(
     let tensions = [99.0, 101.0];
     let pattern = form.iteration_pattern();
     let mut values = vec![0.0; pattern.len()];
-    form.iteration_matrix(&state, &qdd, tensions, c_v, c_q, &mut values);
+    form.iteration_matrix(&state, &qdd, &tensions, c_v, c_q, &mut values);
     let mut model_s = vec![0.0; n * n];
     let mut declared = vec![false; n * n];
     for (&(r, c), v) in pattern.iter().zip(&values) {
@@ -83,14 +85,14 @@ fn check_iteration_matrix(
             let step = 1e-7 * slot.abs().max(1e-2);
             let x0 = *slot;
             *slot = x0 + step;
-            form.residual(&s, &a, tensions, &mut plus);
+            form.residual(&s, &a, &tensions, &mut plus);
             let slot = match which {
                 0 => &mut s[col],
                 1 => &mut s[n + col],
                 _ => &mut a[col],
             };
             *slot = x0 - step;
-            form.residual(&s, &a, tensions, &mut minus);
+            form.residual(&s, &a, &tensions, &mut minus);
             for row in 0..n {
                 fd_s[row * n + col] += weight * (plus[row] - minus[row]) / (2.0 * step);
             }
@@ -158,7 +160,7 @@ fn paper_iteration_matrices_keep_the_cheapest_layout() {
     use cdpr_bench::numerics::sparse::IterationMatrix;
     for kind in ModelKind::MASSIVE {
         let scenario = paper(kind, IntegratorKind::Implicit);
-        let mut sys = ClosedLoop::new(model(&scenario).unwrap(), &scenario);
+        let mut sys = ClosedLoop::new(model(&scenario).unwrap(), &scenario).unwrap();
         let (y, _) = sys.initial_state().unwrap();
         let n = sys.dofs();
         let h = scenario.simulation.step;

@@ -8,9 +8,10 @@
 use cdpr_bench::ModelKind;
 use cdpr_bench::analysis::modes::{self, Loop, ModeKind};
 use cdpr_bench::core::Vector2;
-use cdpr_bench::core::channel::{Cable, Channel};
+use cdpr_bench::core::channel::Channel;
 use cdpr_bench::core::closed_loop::ClosedLoop;
-use cdpr_bench::core::model::CableModel;
+use cdpr_bench::core::model::{CableModel, SplitRule};
+use cdpr_bench::core::robot::CableId;
 use cdpr_bench::core::runner::{RunOptions, simulate_from};
 use cdpr_bench::core::scenario::Scenario;
 use cdpr_bench::core::trajectory::Step5;
@@ -34,17 +35,19 @@ fn scenario(kind: ModelKind) -> Scenario {
 /// geometric stiffness), so ω² are the eigenvalues of K_g/M. Returns (horizontal, vertical) and
 /// §3's single-entry formula √(K_g,zz/M) = √(Σ T_i cos²θ_i/(M l_i)).
 fn elastic_closed_form(
-    model: &Elastic,
+    model: &Elastic<2>,
     effector: Vector2<f64>,
-    tensions: [f64; 2],
+    tensions: &[f64],
 ) -> (f64, f64, f64) {
-    let (mut kxx, mut kxz, mut kzz) = (0.0, 0.0, 0.0);
-    for ((l, e), t) in model.cables(effector).into_iter().zip(tensions) {
+    let (mut kxx, mut kxz, mut kzz) = (0.0f64, 0.0f64, 0.0f64);
+    for (i, t) in tensions.iter().enumerate() {
+        let chord = model.robot.chord(i, &effector);
+        let (l, e) = (chord.length, chord.direction);
         kxx += t / l * (1.0 - e.x * e.x);
         kxz -= t / l * e.x * e.y;
         kzz += t / l * (1.0 - e.y * e.y);
     }
-    let m = model.effector_mass;
+    let m = model.robot.effector_mass;
     let (tr, det) = ((kxx + kzz) / m, (kxx * kzz - kxz * kxz) / (m * m));
     let disc = (0.25 * tr * tr - det).sqrt();
     let (lo, hi) = (0.5 * tr - disc, 0.5 * tr + disc);
@@ -53,7 +56,7 @@ fn elastic_closed_form(
     (
         lo.sqrt(),
         hi.sqrt(),
-        model.vertical_frequency(effector, tensions),
+        model.vertical_frequency(&effector, tensions),
     )
 }
 
@@ -76,8 +79,8 @@ proptest! {
         s.robot.effector_mass = mass;
         prop_assume!(mass * s.robot.gravity < 0.5 * tension_sum);
         let a = analyse(&s, x, Loop::Open).unwrap();
-        let model = Elastic::new(&s);
-        let (wx, wz, w3) = elastic_closed_form(&model, Vector2::new(a.x, a.z), a.tensions);
+        let model = Elastic::from_scenario(&s);
+        let (wx, wz, w3) = elastic_closed_form(&model, Vector2::new(a.x, a.z), &a.tensions);
         let vertical = a.vertical().unwrap().mode;
         let horizontal = a.modes.iter().find(|m| m.kind == ModeKind::Horizontal).unwrap().mode;
         prop_assert!((vertical.omega - wz).abs() < 1e-6 * wz, "ω_z {} vs {}", vertical.omega, wz);
@@ -96,13 +99,13 @@ proptest! {
 fn elastic_vertical_mode_at_the_symmetric_position() {
     let s = scenario(ModelKind::Elastic);
     let open = analyse(&s, 0.5, Loop::Open).unwrap();
-    let model = Elastic::new(&s);
-    let w3 = model.vertical_frequency(Vector2::new(open.x, open.z), open.tensions);
+    let model = Elastic::from_scenario(&s);
+    let w3 = model.vertical_frequency(&Vector2::new(open.x, open.z), &open.tensions);
     let w = open.vertical().unwrap().mode.omega;
     assert!((w - w3).abs() < 1e-6 * w3, "{w} vs {w3}");
     let closed = analyse(&s, 0.6, Loop::Closed).unwrap();
     let wc = closed.vertical().unwrap().mode.omega;
-    let w3 = model.vertical_frequency(Vector2::new(closed.x, closed.z), closed.tensions);
+    let w3 = model.vertical_frequency(&Vector2::new(closed.x, closed.z), &closed.tensions);
     eprintln!("x = 0.6: closed-loop vertical {wc:.4} rad/s, §3 geometric {w3:.4} rad/s");
     assert!((wc - w3).abs() < 1e-3 * w3);
 }
@@ -384,14 +387,16 @@ fn lumped_axial_growth_matches_a_nonlinear_run() {
     };
     let v = &lin.vectors[k];
     let mut model = Lumped::new(&s, Params::default()).unwrap();
-    let eq = model.equilibrium(0.6, s.controller.tension_sum).unwrap();
+    let eq = model
+        .equilibrium(&SplitRule::new(0.6, s.controller.tension_sum))
+        .unwrap();
     let np = model.positions_len();
     let scale = 2e-9 / v[..np].iter().fold(0.0f64, |a, c| a.max(c.0.abs()));
     let mut y0 = lin.state.clone();
     for (yi, c) in y0.iter_mut().zip(v) {
         *yi += scale * c.0;
     }
-    let mut sys = ClosedLoop::new(model, &s);
+    let mut sys = ClosedLoop::new(model, &s).unwrap();
     sys.trajectory = Step5 {
         x1: 0.6,
         x2: 0.6,
@@ -409,10 +414,7 @@ fn lumped_axial_growth_matches_a_nonlinear_run() {
     let run = simulate_from(&mut sys, y0, eq, &opts, &mut |_| {}).unwrap();
     assert!(run.events.is_empty(), "no node passed a pulley");
     let t = run.series.column(Channel::Time).unwrap();
-    let tension = run
-        .series
-        .column(Channel::TPulley(Cable::BOTH[cable]))
-        .unwrap();
+    let tension = run.series.column(Channel::TPulley(CableId(cable))).unwrap();
     let mean = tension.iter().sum::<f64>() / tension.len() as f64;
     let window = 0.05;
     let (mut ts, mut logs) = (Vec::new(), Vec::new());
@@ -482,7 +484,9 @@ fn lumped_open_loop_drift_is_an_oscillation() {
 
     let v = &lin.vectors[k];
     let mut model = Lumped::new(&s, Params::default()).unwrap();
-    let eq = model.equilibrium(0.5, s.controller.tension_sum).unwrap();
+    let eq = model
+        .equilibrium(&SplitRule::new(0.5, s.controller.tension_sum))
+        .unwrap();
     let px = model.xi(0, model.elements);
     let scale = 1e-6 / v[px].0.hypot(v[px].1);
     let mut y0 = lin.state.clone();
@@ -491,7 +495,7 @@ fn lumped_open_loop_drift_is_an_oscillation() {
     }
     let x_eq = lin.state[px];
     let tensions = lin.analysis.tensions;
-    let mut sys = ClosedLoop::new(model, &s);
+    let mut sys = ClosedLoop::new(model, &s).unwrap();
     sys.actuation =
         cdpr_bench::core::closed_loop::Actuation::Prescribed(Box::new(move |_| tensions));
     let opts = RunOptions::dopri5(

@@ -3,7 +3,7 @@
 //! models agreeing with each other within the discretisation error we measure.
 
 use cdpr_bench::ModelKind;
-use cdpr_bench::core::model::CableModel;
+use cdpr_bench::core::model::{CableModel, SplitRule};
 use cdpr_bench::core::scenario::Scenario;
 use cdpr_bench::lumped::Lumped;
 use cdpr_bench::lumped::Params;
@@ -21,7 +21,7 @@ fn lumped_z_at_end(n: usize) -> f64 {
     let s = Scenario::paper();
     let mut m = Lumped::new(&s, Params { elements: n }).unwrap();
     let eq = m
-        .equilibrium(s.trajectory.x2, s.controller.tension_sum)
+        .equilibrium(&SplitRule::new(s.trajectory.x2, s.controller.tension_sum))
         .unwrap();
     m.effector(&eq.state).position.y
 }
@@ -108,7 +108,7 @@ fn paper_scenario_meets_every_section_8_row_with_every_model() {
     );
     let continuum = z80 + (z80 - z40) / (2f64.powf(order) - 1.0);
     let discretisation = (z40 - continuum).abs();
-    let fe_static = fe.end.state().unwrap().effector.y;
+    let fe_static = fe.end.state().unwrap().effector_height();
     assert!(
         (fe_static - continuum).abs() < 0.05 * discretisation,
         "FE {fe_static} vs {continuum}"

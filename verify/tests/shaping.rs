@@ -213,7 +213,7 @@ fn shaped_reference_is_step5_convolved_with_the_impulses() {
          shaper_frequency = 20.0\nshaper_damping = 0.01\n",
     )
     .unwrap();
-    let sys = ClosedLoop::new(Elastic::new(&s), &s);
+    let sys = ClosedLoop::new(Elastic::from_scenario(&s), &s).unwrap();
     let shaper = s.trajectory.impulses().unwrap().unwrap();
     let step = Step5::from(&s.trajectory);
     for k in 0..=1000 {

@@ -158,8 +158,8 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
                 .map(|(o, end)| ModelEntry {
                     metrics: &o.metrics,
                     vertical_mode: end.mode,
-                    x2_effector_z: end.effector.y,
-                    x2_force: end.equilibrium.force,
+                    x2_effector_z: end.effector_height(),
+                    x2_force: end.equilibrium.force(),
                 })
                 .collect(),
             checks: &checks,
@@ -518,8 +518,8 @@ fn write_markdown(
                 o.kind,
                 fixed(o.metrics.z0, 7),
                 fixed(o.metrics.f0, 6),
-                fixed(end.effector.y, 7),
-                fixed(end.equilibrium.force, 6)
+                fixed(end.effector_height(), 7),
+                fixed(end.equilibrium.force(), 6)
             )?;
         }
 

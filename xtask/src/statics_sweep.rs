@@ -6,7 +6,7 @@
 use crate::output::Progress;
 use crate::simulate::{load_scenario, model_kind};
 use anyhow::{Result, bail};
-use cdpr_bench::core::model::CableModel;
+use cdpr_bench::core::model::{CableModel, SplitRule};
 use cdpr_bench::core::scenario::Scenario;
 use cdpr_bench::{ModelKind, ModelVisitor};
 use std::path::Path;
@@ -66,14 +66,14 @@ pub fn sweep(
     }
     impl ModelVisitor for Grid<'_> {
         type Output = Vec<Failure>;
-        fn visit<M: CableModel + Clone + Send + 'static>(self, built: M) -> Vec<Failure> {
+        fn visit<M: CableModel<2> + Clone + Send + 'static>(self, built: M) -> Vec<Failure> {
             let mut failures = Vec::new();
             for i in 0..self.x.steps {
                 for j in 0..self.tension_sum.steps {
                     let (at, sum) = (self.x.at(i), self.tension_sum.at(j));
                     // A fresh copy per start: the lumped model's stored/free split is part of
                     // its state, and an equilibrium changes it.
-                    if let Err(e) = built.clone().equilibrium(at, sum) {
+                    if let Err(e) = built.clone().equilibrium(&SplitRule::new(at, sum)) {
                         failures.push(Failure {
                             x: at,
                             tension_sum: sum,

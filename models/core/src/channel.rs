@@ -3,6 +3,9 @@
 //! massive-cable model provides. Naming a channel by this enum, not by its string, makes a
 //! misspelt channel a compile error instead of an empty column.
 
+use crate::robot::{CableId, axis_name};
+use std::fmt;
+
 /// A channel of the time series.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Channel {
@@ -12,16 +15,16 @@ pub enum Channel {
     XRef,
     /// Effector x [m].
     X,
+    /// Effector y [m] (spatial robots).
+    Y,
     /// Effector z [m].
     Z,
     /// Error e = x_ref − x [m].
     Error,
-    /// Controller force F [N].
+    /// The horizontal force F the controller asks of the cables [N].
     Force,
-    /// Commanded tension T1 [N].
-    T1,
-    /// Commanded tension T2 [N].
-    T2,
+    /// Commanded tension of a cable [N].
+    Tension(CableId),
     /// Kinetic energy [J].
     EKinetic,
     /// Elastic energy [J].
@@ -34,48 +37,21 @@ pub enum Channel {
     EDissipated,
     /// Energy balance E(t) − E(0) − W(t) + D(t) − ΣΔE [J].
     EResidual,
-    /// Tension at the effector end of cable 1 or 2 [N] (massive-cable models).
-    TEffector(Cable),
-    /// Tension next to the pulley of cable 1 or 2 [N] (massive-cable models).
-    TPulley(Cable),
-    /// Free unstrained length of cable 1 or 2 [m] (massive-cable models).
-    LFree(Cable),
-    /// Stored amount of cable 1 or 2 (lumped: nodes; FE: length ρ_i [m]).
-    Stored(Cable),
-}
-
-/// Cable 1 (over pulley A1) or cable 2 (over A2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Cable {
-    One,
-    Two,
-}
-
-impl Cable {
-    /// Both cables, in order.
-    pub const BOTH: [Cable; 2] = [Cable::One, Cable::Two];
-
-    /// The cable's index in per-cable arrays (0 or 1).
-    pub fn index(self) -> usize {
-        match self {
-            Cable::One => 0,
-            Cable::Two => 1,
-        }
-    }
+    /// Tension at the effector end of a cable [N] (massive-cable models).
+    TEffector(CableId),
+    /// Tension next to a cable's pulley [N] (massive-cable models).
+    TPulley(CableId),
+    /// Free unstrained length of a cable [m] (massive-cable models).
+    LFree(CableId),
+    /// Stored amount of a cable (lumped: nodes; FE: length ρ_i [m]).
+    Stored(CableId),
 }
 
 impl Channel {
-    /// The channels every run has, in order, before the model's own.
-    pub const COMMON: [Channel; 8] = [
-        Channel::Time,
-        Channel::XRef,
-        Channel::X,
-        Channel::Z,
-        Channel::Error,
-        Channel::Force,
-        Channel::T1,
-        Channel::T2,
-    ];
+    /// The commanded tension of cable 1.
+    pub const T1: Channel = Channel::Tension(CableId(0));
+    /// The commanded tension of cable 2.
+    pub const T2: Channel = Channel::Tension(CableId(1));
 
     /// The energy channels every run has, after the model's own [J].
     pub const ENERGY: [Channel; 6] = [
@@ -87,57 +63,77 @@ impl Channel {
         Channel::EResidual,
     ];
 
-    /// The channels every massive-cable model provides as its own, named alike so that the report
-    /// and the cross-model tests compare them.
-    pub const CABLE: [Channel; 8] = [
-        Channel::TEffector(Cable::One),
-        Channel::TEffector(Cable::Two),
-        Channel::TPulley(Cable::One),
-        Channel::TPulley(Cable::Two),
-        Channel::LFree(Cable::One),
-        Channel::LFree(Cable::Two),
-        Channel::Stored(Cable::One),
-        Channel::Stored(Cable::Two),
-    ];
-
-    /// The column's name in the time series and its CSV header.
-    pub fn name(self) -> &'static str {
-        use Cable::{One, Two};
-        match self {
-            Channel::Time => "t",
-            Channel::XRef => "x_ref",
-            Channel::X => "x",
-            Channel::Z => "z",
-            Channel::Error => "error",
-            Channel::Force => "F",
-            Channel::T1 => "T1",
-            Channel::T2 => "T2",
-            Channel::EKinetic => "e_kinetic",
-            Channel::EElastic => "e_elastic",
-            Channel::EGravity => "e_gravity",
-            Channel::WReel => "w_reel",
-            Channel::EDissipated => "e_dissipated",
-            Channel::EResidual => "e_residual",
-            Channel::TEffector(One) => "T_effector_1",
-            Channel::TEffector(Two) => "T_effector_2",
-            Channel::TPulley(One) => "T_pulley_1",
-            Channel::TPulley(Two) => "T_pulley_2",
-            Channel::LFree(One) => "l_free_1",
-            Channel::LFree(Two) => "l_free_2",
-            Channel::Stored(One) => "stored_1",
-            Channel::Stored(Two) => "stored_2",
+    /// The effector's coordinate along axis `k` of a D-dimensional robot.
+    pub fn axis<const D: usize>(k: usize) -> Channel {
+        match axis_name::<D>(k) {
+            "x" => Channel::X,
+            "y" => Channel::Y,
+            _ => Channel::Z,
         }
     }
-}
 
-impl Channel {
+    /// The channels every run of a D-dimensional robot with `cables` cables has, in order,
+    /// before the model's own: t, x_ref, the effector's coordinates, the error, the force, T1 …
+    /// Tm (the plane: `t, x_ref, x, z, error, F, T1, T2`).
+    pub fn common<const D: usize>(cables: usize) -> Vec<Channel> {
+        let mut channels = vec![Channel::Time, Channel::XRef];
+        channels.extend((0..D).map(Channel::axis::<D>));
+        channels.extend([Channel::Error, Channel::Force]);
+        channels.extend(CableId::all(cables).map(Channel::Tension));
+        channels
+    }
+
+    /// The channels every massive-cable model provides as its own, named alike so that the
+    /// report and the cross-model tests compare them: per kind, cable 1 … m.
+    pub fn cable_channels(cables: usize) -> Vec<Channel> {
+        let kinds: [fn(CableId) -> Channel; 4] = [
+            Channel::TEffector,
+            Channel::TPulley,
+            Channel::LFree,
+            Channel::Stored,
+        ];
+        kinds
+            .iter()
+            .flat_map(|kind| CableId::all(cables).map(kind))
+            .collect()
+    }
+
+    /// The column's name in the time series and its CSV heading.
+    pub fn name(self) -> String {
+        match self {
+            Channel::Time => "t".into(),
+            Channel::XRef => "x_ref".into(),
+            Channel::X => "x".into(),
+            Channel::Y => "y".into(),
+            Channel::Z => "z".into(),
+            Channel::Error => "error".into(),
+            Channel::Force => "F".into(),
+            Channel::Tension(c) => format!("T{c}"),
+            Channel::EKinetic => "e_kinetic".into(),
+            Channel::EElastic => "e_elastic".into(),
+            Channel::EGravity => "e_gravity".into(),
+            Channel::WReel => "w_reel".into(),
+            Channel::EDissipated => "e_dissipated".into(),
+            Channel::EResidual => "e_residual".into(),
+            Channel::TEffector(c) => format!("T_effector_{c}"),
+            Channel::TPulley(c) => format!("T_pulley_{c}"),
+            Channel::LFree(c) => format!("l_free_{c}"),
+            Channel::Stored(c) => format!("stored_{c}"),
+        }
+    }
+
     /// The channel's SI unit ("" where a model sets it: lumped storage counts nodes, FE's is a
     /// length).
     pub fn unit(self) -> &'static str {
         match self {
             Channel::Time => "s",
-            Channel::XRef | Channel::X | Channel::Z | Channel::Error | Channel::LFree(_) => "m",
-            Channel::Force | Channel::T1 | Channel::T2 => "N",
+            Channel::XRef
+            | Channel::X
+            | Channel::Y
+            | Channel::Z
+            | Channel::Error
+            | Channel::LFree(_) => "m",
+            Channel::Force | Channel::Tension(_) => "N",
             Channel::TEffector(_) | Channel::TPulley(_) => "N",
             Channel::EKinetic
             | Channel::EElastic
@@ -149,12 +145,14 @@ impl Channel {
         }
     }
 
-    /// The channel called `name`, if it is one of these.
+    /// The channel called `name`, if it is one of these (cables up to
+    /// [`crate::robot::MAX_CABLES`]).
     pub fn named(name: &str) -> Option<Channel> {
-        Self::COMMON
+        let m = crate::robot::MAX_CABLES;
+        Self::common::<3>(m)
             .into_iter()
             .chain(Self::ENERGY)
-            .chain(Self::CABLE)
+            .chain(Self::cable_channels(m))
             .find(|c| c.name() == name)
     }
 }
@@ -169,8 +167,8 @@ pub fn heading(name: &str, unit: &str) -> String {
     }
 }
 
-impl std::fmt::Display for Channel {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
+impl fmt::Display for Channel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.name())
     }
 }

@@ -14,6 +14,7 @@ pub mod controller;
 pub mod geometry;
 pub mod modal_layout;
 pub mod model;
+pub mod robot;
 pub mod runner;
 pub mod scenario;
 pub mod second_order;

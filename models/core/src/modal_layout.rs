@@ -3,22 +3,20 @@
 //! the cable (lumped stored nodes, FE lengths l_i and ρ_i), and which a constraint holds fixed
 //! (lumped stored nodes' z, MODELS.md §4 eq. 6). Each model states it
 //! ([`crate::model::CableModel::modal_layout`]); the analysis classifies modes from it without
-//! knowing any model.
-
-use nalgebra::Vector2;
+//! knowing any model. Coordinates are listed per axis, x first and z last, in any dimension.
 
 /// What a group of position coordinates is, for the classification (indices into the model's
 /// position coordinates, i.e. the first half of its state).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Dof {
-    /// The effector's x and z, mass M [kg].
-    Effector { x: usize, z: usize, mass: f64 },
-    /// A free cable node: its displacement along `tangent` is axial, across it transverse.
+    /// The effector's coordinates (one per axis, the vertical last), mass M [kg].
+    Effector { coordinates: Vec<usize>, mass: f64 },
+    /// A free cable node: its displacement along `tangent` (a unit vector, one component per
+    /// axis) is axial, across it transverse.
     Node {
         cable: usize,
-        x: usize,
-        z: usize,
-        tangent: Vector2<f64>,
+        coordinates: Vec<usize>,
+        tangent: Vec<f64>,
         mass: f64,
     },
     /// A coordinate that moves material along the cable (lumped stored node's x, FE l_i and ρ_i),

@@ -3,12 +3,99 @@
 //! A model owns its physical state layout (effector and cable coordinates and velocities), computes
 //! its right-hand side for given commanded tensions, and reports the effector, its energy and the
 //! extra output channels it has. It knows nothing of the controller, the trajectory or the
-//! integrator; the closed loop ([`crate::closed_loop`]) knows nothing of cables.
+//! integrator; the closed loop ([`crate::closed_loop`]) knows nothing of cables. The robot's
+//! space is the type parameter D ([`crate::robot::space`]).
+//!
+//! # Examples
+//!
+//! A model of one's own: the effector on two rigid-length springs that carry the commanded
+//! tensions unchanged (the elastic model without its unstrained lengths). It states its state
+//! layout, its right-hand side, its statics under the closed loop's rest rule, and its energy.
+//!
+//! ```
+//! use cdpr_core::model::{CableModel, Energy, Equilibrium, ModelError, RestRule};
+//! use cdpr_core::modal_layout::{Dof, ModalLayout};
+//! use cdpr_core::robot::{Effector, PerCable, Robot, Tensions, Vector, height};
+//!
+//! #[derive(Clone)]
+//! struct Strings { robot: Robot<2> }
+//!
+//! impl CableModel<2> for Strings {
+//!     fn name(&self) -> &'static str { "strings" }
+//!     fn robot(&self) -> &Robot<2> { &self.robot }
+//!     fn state_len(&self) -> usize { 4 } // x, z, ẋ, ż
+//!     fn rhs(&mut self, _t: f64, y: &[f64], tensions: &[f64], rate: &mut [f64]) {
+//!         let p = Vector::<2>::new(y[0], y[1]);
+//!         let force = self.robot.structure_matrix(&p).force(tensions) + self.robot.weight();
+//!         rate[..2].copy_from_slice(&y[2..]);
+//!         rate[2] = force.x / self.robot.effector_mass;
+//!         rate[3] = force.y / self.robot.effector_mass;
+//!     }
+//!     fn effector(&self, y: &[f64]) -> Effector<2> {
+//!         Effector { position: Vector::<2>::new(y[0], y[1]), velocity: Vector::<2>::new(y[2], y[3]) }
+//!     }
+//!     fn reel_speeds(&self, y: &[f64]) -> PerCable {
+//!         let e = self.effector(y);
+//!         let w = self.robot.structure_matrix(&e.position);
+//!         PerCable::from_fn(2, |i| w.column(i).dot(&e.velocity))
+//!     }
+//!     fn energy(&self, y: &[f64]) -> Energy {
+//!         let m = self.robot.effector_mass;
+//!         Energy {
+//!             kinetic: 0.5 * m * (y[2] * y[2] + y[3] * y[3]),
+//!             elastic: 0.0,
+//!             gravity: m * self.robot.gravity * y[1],
+//!         }
+//!     }
+//!     /// The rule pins x; z and the rule's parameter follow from the force balance, solved
+//!     /// here by a few Newton steps of the 2 × 2 balance (a real model uses `cdpr_numerics::newton`).
+//!     fn equilibrium(&mut self, rule: &dyn RestRule<2>) -> Result<Equilibrium, ModelError> {
+//!         let x = rule.pinned()[0].1;
+//!         let (mut z, mut lambda) = (-0.1, 0.0);
+//!         let balance = |z: f64, lambda: f64| {
+//!             let p = Vector::<2>::new(x, z);
+//!             self.robot.structure_matrix(&p).force(&rule.tensions(&[lambda])) + self.robot.weight()
+//!         };
+//!         for _ in 0..50 {
+//!             let f = balance(z, lambda);
+//!             let (h, k) = (1e-7, 1e-4);
+//!             let fz = (balance(z + h, lambda) - f) / h;
+//!             let fl = (balance(z, lambda + k) - f) / k;
+//!             let det = fz.x * fl.y - fl.x * fz.y;
+//!             z -= (fl.y * f.x - fl.x * f.y) / det;
+//!             lambda -= (fz.x * f.y - fz.y * f.x) / det;
+//!         }
+//!         Ok(Equilibrium {
+//!             state: vec![x, z, 0.0, 0.0],
+//!             tensions: rule.tensions(&[lambda]),
+//!             parameters: vec![lambda],
+//!             iterations: 50,
+//!             residual: balance(z, lambda).norm(),
+//!         })
+//!     }
+//!     fn channel_names(&self) -> Vec<String> { Vec::new() }
+//!     fn channels(&self, _: &[f64], _: &[f64], _: &mut [f64]) {}
+//!     fn modal_layout(&self, _: &[f64]) -> ModalLayout {
+//!         ModalLayout {
+//!             dofs: vec![Dof::Effector { coordinates: vec![0, 1], mass: self.robot.effector_mass }],
+//!             frozen: Vec::new(),
+//!         }
+//!     }
+//! }
+//!
+//! // At rest under the paper's rule (x pinned, ΣT = 200 N split by the unknown force F0).
+//! let robot = Robot::new(&[Vector::<2>::new(0.0, 0.0), Vector::<2>::new(1.0, 0.0)], 1.0, 9.81)?;
+//! let mut model = Strings { robot };
+//! let eq = model.equilibrium(&cdpr_core::model::SplitRule::new(0.5, 200.0))?;
+//! assert!((eq.state[1] + 0.0245546).abs() < 1e-6, "the paper's sag (MODELS.md §2)");
+//! assert!(eq.parameters[0].abs() < 1e-9, "no horizontal force at mid-span");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use crate::modal_layout::ModalLayout;
+use crate::robot::{Effector, PerCable, Robot, Tensions};
 use crate::scenario::{Scenario, ScenarioError};
 use crate::second_order::SecondOrderForm;
-use nalgebra::Vector2;
 
 /// Why a model refused a state or could not find its equilibrium.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -23,16 +110,13 @@ pub enum ModelError {
     /// The static equilibrium of MODELS.md §2 was not found.
     #[error("static equilibrium not found: {0}")]
     Equilibrium(#[from] cdpr_numerics::newton::NewtonError),
-    /// The controller could not be designed for the loop's rest point.
-    #[error(transparent)]
-    Control(#[from] crate::controller::ControlError),
     /// The state left the model's domain (e.g. a node ordering the pulley rule forbids).
     #[error("invalid model state at t = {t} s: {why}")]
     State { t: f64, why: String },
 }
 
-/// MODELS.md §2 holds the effector's x fixed for the static equilibrium: it must lie strictly
-/// between the pulleys A1 = (0, 0) and A2 = (d, 0).
+/// MODELS.md §2 holds the effector's x fixed for the static equilibrium: it must lie in the
+/// robot's workspace (the plane: strictly between the pulleys A1 = (0, 0) and A2 = (d, 0)).
 pub fn check_effector_x(effector_x: f64, anchor_distance: f64) -> Result<(), ModelError> {
     if effector_x > 0.0 && effector_x < anchor_distance {
         Ok(())
@@ -45,11 +129,61 @@ pub fn check_effector_x(effector_x: f64, anchor_distance: f64) -> Result<(), Mod
     }
 }
 
-/// Position and velocity of the effector (the point mass C of the paper) [m, m/s].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Effector {
-    pub position: Vector2<f64>,
-    pub velocity: Vector2<f64>,
+/// How the robot and its controller hold the effector at rest (MODELS.md §2), which a model's
+/// statics solves with: effector coordinates pinned at values, and the commanded tensions as a
+/// function of as many unknown parameters, affine in them. The paper's PID: x pinned, F0 free,
+/// T = ((ΣT − F0)/2, (ΣT + F0)/2) ([`SplitRule`]). The model finds its coordinates but the
+/// pinned ones and the parameters from its force balance.
+pub trait RestRule<const D: usize> {
+    /// The pinned effector coordinates: (axis, value [m]).
+    fn pinned(&self) -> &[(usize, f64)];
+    /// The commanded tensions for the `parameters` (one per pinned coordinate) [N].
+    fn tensions(&self, parameters: &[f64]) -> Tensions;
+    /// dT/dλ_j, the same for every λ (the rule is affine).
+    fn slope(&self, j: usize) -> Tensions;
+    /// A typical size of parameter j, the Newton scale of its unknown [N].
+    fn scale(&self, j: usize) -> f64;
+}
+
+/// The paper's rest rule (MODELS.md §2): the effector's x pinned at `x` [m], ΣT = `tension_sum`
+/// [N] split by the unknown horizontal force F0 into T1 = (ΣT − F0)/2, T2 = (ΣT + F0)/2.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SplitRule {
+    pinned: [(usize, f64); 1],
+    pub tension_sum: f64,
+}
+
+impl SplitRule {
+    pub fn new(x: f64, tension_sum: f64) -> Self {
+        Self {
+            pinned: [(0, x)],
+            tension_sum,
+        }
+    }
+
+    /// The pinned x [m].
+    pub fn x(&self) -> f64 {
+        self.pinned[0].1
+    }
+}
+
+impl<const D: usize> RestRule<D> for SplitRule {
+    fn pinned(&self) -> &[(usize, f64)] {
+        &self.pinned
+    }
+    fn tensions(&self, parameters: &[f64]) -> Tensions {
+        Tensions::pair(crate::controller::split_tensions(
+            self.tension_sum,
+            parameters[0],
+        ))
+    }
+    fn slope(&self, _: usize) -> Tensions {
+        Tensions::pair([-0.5, 0.5])
+    }
+    /// ΣT: F0 is a share of it.
+    fn scale(&self, _: usize) -> f64 {
+        self.tension_sum
+    }
 }
 
 /// Energy terms of a state [J]; gravity's zero is at z = 0 (the pulleys' height).
@@ -70,17 +204,27 @@ impl Energy {
     }
 }
 
-/// Static equilibrium of MODELS.md §2: effector x held at x_ref(0), the PID's force F0 an unknown.
+/// Static equilibrium under a [`RestRule`] (MODELS.md §2: the effector's x held at x_ref(0), the
+/// PID's force F0 an unknown).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Equilibrium {
     /// The model's state at rest.
     pub state: Vec<f64>,
-    /// Horizontal force F0 [N] the tension distribution must supply: T1 = (ΣT − F0)/2, T2 = (ΣT + F0)/2.
-    pub force: f64,
+    /// The rule's parameters found (the paper's rule: F0 [N]).
+    pub parameters: Vec<f64>,
+    /// The commanded tensions they give [N].
+    pub tensions: Tensions,
     /// Newton iterations used.
     pub iterations: usize,
     /// Largest force residual at the solution [N].
     pub residual: f64,
+}
+
+impl Equilibrium {
+    /// The paper's rule's force F0 [N] (its first parameter; NaN under a rule without one).
+    pub fn force(&self) -> f64 {
+        self.parameters.first().copied().unwrap_or(f64::NAN)
+    }
 }
 
 /// A discrete change of a model's state at a located time (e.g. a lumped node passing a pulley).
@@ -88,7 +232,7 @@ pub struct Equilibrium {
 pub struct ModelEvent {
     /// Time of the event [s] (located to 1e-12 s on the dense output).
     pub t: f64,
-    /// Cable concerned (1 or 2).
+    /// Cable concerned (1 … m).
     pub cable: usize,
     /// What happened, in the model's words (e.g. "node 19 leaves the reel").
     pub what: String,
@@ -96,31 +240,37 @@ pub struct ModelEvent {
     pub energy_change: f64,
 }
 
-/// A cable model of the two-cable planar CDPR: state, right-hand side, energy and tensions.
+/// A cable model of a robot in D dimensions: state, right-hand side, energy and tensions.
 ///
-/// The commanded tensions `[T1, T2]` act at the reels; how they reach the effector is the model's
+/// The commanded tensions T_1 … T_m act at the reels; how they reach the effector is the model's
 /// physics. Implementations must not allocate in [`CableModel::rhs`].
-pub trait CableModel {
+pub trait CableModel<const D: usize> {
     /// Short name used in files and tables ("elastic", "lumped", "fe").
     fn name(&self) -> &'static str;
+
+    /// The robot the cables belong to (its anchors, effector mass, gravity).
+    fn robot(&self) -> &Robot<D>;
+
+    /// Number of cables m.
+    fn cables(&self) -> usize {
+        self.robot().cables()
+    }
 
     /// Number of components of the model's state vector.
     fn state_len(&self) -> usize;
 
-    /// Static equilibrium with the effector's x fixed at `effector_x` [m] and commanded tensions
-    /// T1 = (ΣT − F0)/2, T2 = (ΣT + F0)/2, F0 an unknown; all velocities zero (MODELS.md §2).
-    fn equilibrium(&mut self, effector_x: f64, tension_sum: f64)
-    -> Result<Equilibrium, ModelError>;
+    /// Static equilibrium under `rule`, all velocities zero (MODELS.md §2).
+    fn equilibrium(&mut self, rule: &dyn RestRule<D>) -> Result<Equilibrium, ModelError>;
 
-    /// State derivative for the commanded tensions `[T1, T2]` [N] at time `t` [s].
-    fn rhs(&mut self, t: f64, state: &[f64], tensions: [f64; 2], rate: &mut [f64]);
+    /// State derivative for the commanded tensions T_1 … T_m [N] at time `t` [s].
+    fn rhs(&mut self, t: f64, state: &[f64], tensions: &[f64], rate: &mut [f64]);
 
     /// The effector's position and velocity in `state`.
-    fn effector(&self, state: &[f64]) -> Effector;
+    fn effector(&self, state: &[f64]) -> Effector<D>;
 
     /// Rate at which each reel takes in cable [m/s] (positive: reeling in). The reels' power is
     /// Σ T_i v_reel,i, so that d/dt (kinetic + elastic + gravity) = Σ T_i v_reel,i − dissipation.
-    fn reel_speeds(&self, state: &[f64]) -> [f64; 2];
+    fn reel_speeds(&self, state: &[f64]) -> PerCable;
 
     /// Energy terms of `state`.
     fn energy(&self, state: &[f64]) -> Energy;
@@ -154,11 +304,11 @@ pub trait CableModel {
         })
     }
 
-    /// Names of the model's own output channels (with units), after the common ones.
+    /// Names of the model's own output channels, after the common ones.
     fn channel_names(&self) -> Vec<String>;
 
-    /// Values of [`CableModel::channel_names`] for `state` under the tensions `[T1, T2]`.
-    fn channels(&self, state: &[f64], tensions: [f64; 2], out: &mut [f64]);
+    /// Values of [`CableModel::channel_names`] for `state` under the tensions `tensions`.
+    fn channels(&self, state: &[f64], tensions: &[f64], out: &mut [f64]);
 
     /// The unit of each of [`CableModel::channel_names`] ("" for a count or a ratio); by
     /// default [`crate::channel::Channel::unit`] of the channels named alike, "" for others.
@@ -187,7 +337,7 @@ pub trait CableModel {
 /// A model's own parameters (its keys of the scenario's `[model]` section): what checks a
 /// scenario against the model's needs and builds the model from it.
 pub trait ModelParams: serde::Serialize {
-    type Model: CableModel + Clone + Send + 'static;
+    type Model: CableModel<2> + Clone + Send + 'static;
     /// The model's own checks of the scenario (e.g. enough modelled cable for the trajectory),
     /// before any work starts.
     fn validate(&self, scenario: &Scenario) -> Result<(), ScenarioError>;
@@ -196,29 +346,31 @@ pub trait ModelParams: serde::Serialize {
 }
 
 /// A boxed model is a model: one dispatcher can hand any model to the closed loop
-/// (`ClosedLoop<Box<dyn CableModel + Send>>`); the model's own arithmetic stays statically
+/// (`ClosedLoop<Box<dyn CableModel<D> + Send>, D>`); the model's own arithmetic stays statically
 /// dispatched, and one virtual call per right-hand side is negligible next to it.
-impl<M: CableModel + ?Sized> CableModel for Box<M> {
+impl<const D: usize, M: CableModel<D> + ?Sized> CableModel<D> for Box<M> {
     fn name(&self) -> &'static str {
         (**self).name()
+    }
+    fn robot(&self) -> &Robot<D> {
+        (**self).robot()
+    }
+    fn cables(&self) -> usize {
+        (**self).cables()
     }
     fn state_len(&self) -> usize {
         (**self).state_len()
     }
-    fn equilibrium(
-        &mut self,
-        effector_x: f64,
-        tension_sum: f64,
-    ) -> Result<Equilibrium, ModelError> {
-        (**self).equilibrium(effector_x, tension_sum)
+    fn equilibrium(&mut self, rule: &dyn RestRule<D>) -> Result<Equilibrium, ModelError> {
+        (**self).equilibrium(rule)
     }
-    fn rhs(&mut self, t: f64, state: &[f64], tensions: [f64; 2], rate: &mut [f64]) {
+    fn rhs(&mut self, t: f64, state: &[f64], tensions: &[f64], rate: &mut [f64]) {
         (**self).rhs(t, state, tensions, rate)
     }
-    fn effector(&self, state: &[f64]) -> Effector {
+    fn effector(&self, state: &[f64]) -> Effector<D> {
         (**self).effector(state)
     }
-    fn reel_speeds(&self, state: &[f64]) -> [f64; 2] {
+    fn reel_speeds(&self, state: &[f64]) -> PerCable {
         (**self).reel_speeds(state)
     }
     fn energy(&self, state: &[f64]) -> Energy {
@@ -244,7 +396,7 @@ impl<M: CableModel + ?Sized> CableModel for Box<M> {
     fn channel_names(&self) -> Vec<String> {
         (**self).channel_names()
     }
-    fn channels(&self, state: &[f64], tensions: [f64; 2], out: &mut [f64]) {
+    fn channels(&self, state: &[f64], tensions: &[f64], out: &mut [f64]) {
         (**self).channels(state, tensions, out)
     }
     fn channel_units(&self) -> Vec<&'static str> {

@@ -3,9 +3,10 @@
 //! and stops with a reason ([`RunError`]) while keeping what it sampled ([`RunFailure`]).
 
 use crate::channel::Channel;
-use crate::closed_loop::ClosedLoop;
-use crate::controller::Controller;
+use crate::closed_loop::{ClosedLoop, LoopError};
+use crate::controller::{ControlError, Controller};
 use crate::model::{CableModel, Equilibrium, ModelError, ModelEvent};
+use crate::robot::{CableId, Tensions};
 use crate::scenario::{ImplicitMethod, IntegratorKind, Scenario};
 use crate::series::{SeriesBuffer, TimeSeries};
 use cdpr_numerics::{
@@ -20,20 +21,27 @@ use std::time::Instant;
 pub enum RunError {
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// The controller could not be designed at the run's start.
+    #[error(transparent)]
+    Control(#[from] ControlError),
+    /// The loop could not be assembled (e.g. a controller with more states than it holds).
+    #[error("{0}")]
+    Loop(String),
     /// The integrator's error is part of the message (not a `source`, which a chain would print
     /// twice).
     #[error("integrator failed at t = {t} s: {error}")]
     Integrator { t: f64, error: IntegratorError },
-    /// The effector left the workspace below the pulleys, 0 < x < d, z < 0 (a run gone
-    /// unstable: its numbers past here describe no robot).
+    /// The effector left the workspace (below the highest anchor and, seen from above, inside
+    /// the anchors' hull; the plane: 0 < x < d, z < 0): a run gone unstable, its numbers past
+    /// here describe no robot.
     #[error(
-        "the effector left the workspace at t = {t} s: (x, z) = ({x}, {z}) m, allowed 0 < x < {anchor_distance} m and z < 0"
+        "the effector left the workspace at t = {t} s: {}, allowed below the highest anchor and between the anchors",
+        coordinates(position)
     )]
     Workspace {
         t: f64,
-        x: f64,
-        z: f64,
-        anchor_distance: f64,
+        /// The effector's coordinates [m], per axis, the vertical last.
+        position: Vec<f64>,
     },
     /// The shaper's design is still "auto": the modal analysis must resolve it first.
     #[error(
@@ -43,7 +51,11 @@ pub enum RunError {
     UnresolvedShaper,
     /// A commanded tension ≤ 0 (MODELS.md §2): a cable cannot push.
     #[error("cable {cable} went slack at t = {t} s: commanded tension {tension} N ≤ 0")]
-    SlackCable { t: f64, cable: usize, tension: f64 },
+    SlackCable {
+        t: f64,
+        cable: CableId,
+        tension: f64,
+    },
     /// Stopped from outside (an interrupt) after the step that reached `t`.
     #[error("interrupted at t = {t} s")]
     Interrupted { t: f64 },
@@ -56,6 +68,31 @@ pub enum RunError {
         model: &'static str,
         why: &'static str,
     },
+}
+
+/// "x = …, z = … m" (or x, y, z in space) for a message.
+fn coordinates(position: &[f64]) -> String {
+    let names: &[&str] = if position.len() == 3 {
+        &["x", "y", "z"]
+    } else {
+        &["x", "z"]
+    };
+    let parts: Vec<String> = position
+        .iter()
+        .zip(names)
+        .map(|(value, name)| format!("{name} = {value}"))
+        .collect();
+    format!("{} m", parts.join(", "))
+}
+
+impl From<LoopError> for RunError {
+    fn from(e: LoopError) -> Self {
+        match e {
+            LoopError::Model(e) => RunError::Model(e),
+            LoopError::Control(e) => RunError::Control(e),
+            e @ LoopError::ControllerStates { .. } => RunError::Loop(e.to_string()),
+        }
+    }
 }
 
 /// Output of a run: sampled channels, counters, the initial equilibrium, the state at the end.
@@ -169,18 +206,24 @@ impl From<&Scenario> for RunOptions {
     }
 }
 
-/// The names of a run's channels with `model`, in order: [`Channel::COMMON`], the model's own,
+/// The names of a run's channels with `model`, in order: [`Channel::common`], the model's own,
 /// [`Channel::ENERGY`].
-pub fn channel_names<M: CableModel + ?Sized>(model: &M) -> Vec<String> {
-    let mut names: Vec<String> = Channel::COMMON.map(|c| c.name().to_owned()).to_vec();
+pub fn channel_names<const D: usize, M: CableModel<D> + ?Sized>(model: &M) -> Vec<String> {
+    let mut names: Vec<String> = Channel::common::<D>(model.cables())
+        .into_iter()
+        .map(Channel::name)
+        .collect();
     names.extend(model.channel_names());
-    names.extend(Channel::ENERGY.map(|c| c.name().to_owned()));
+    names.extend(Channel::ENERGY.map(Channel::name));
     names
 }
 
 /// The units of [`channel_names`], in order.
-pub fn channel_units<M: CableModel + ?Sized>(model: &M) -> Vec<&'static str> {
-    let mut units: Vec<&'static str> = Channel::COMMON.map(Channel::unit).to_vec();
+pub fn channel_units<const D: usize, M: CableModel<D> + ?Sized>(model: &M) -> Vec<&'static str> {
+    let mut units: Vec<&'static str> = Channel::common::<D>(model.cables())
+        .into_iter()
+        .map(Channel::unit)
+        .collect();
     units.extend(model.channel_units());
     units.extend(Channel::ENERGY.map(Channel::unit));
     units
@@ -232,8 +275,8 @@ impl<'a> Observer<'a> {
 /// Integrates the loop from its MODELS.md §2 initial state to `t_final`, sampling every
 /// `sample_period` on the dense output. `progress` receives the fraction of time done after each
 /// accepted step.
-pub fn simulate<M: CableModel>(
-    sys: &mut ClosedLoop<M>,
+pub fn simulate<M: CableModel<D>, const D: usize>(
+    sys: &mut ClosedLoop<M, D>,
     opts: &RunOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Run, Box<RunFailure>> {
@@ -241,8 +284,8 @@ pub fn simulate<M: CableModel>(
 }
 
 /// The loop's MODELS.md §2 initial state, or the failure of a run that could not start.
-fn initial_state<M: CableModel>(
-    sys: &mut ClosedLoop<M>,
+fn initial_state<M: CableModel<D>, const D: usize>(
+    sys: &mut ClosedLoop<M, D>,
 ) -> Result<(Vec<f64>, Equilibrium), Box<RunFailure>> {
     sys.initial_state().map_err(|e| {
         Box::new(RunFailure {
@@ -253,8 +296,8 @@ fn initial_state<M: CableModel>(
 }
 
 /// As [`simulate`], watched and steered by `observer`.
-pub fn simulate_observed<M: CableModel>(
-    sys: &mut ClosedLoop<M>,
+pub fn simulate_observed<M: CableModel<D>, const D: usize>(
+    sys: &mut ClosedLoop<M, D>,
     opts: &RunOptions,
     observer: &mut Observer,
 ) -> Result<Run, Box<RunFailure>> {
@@ -262,8 +305,8 @@ pub fn simulate_observed<M: CableModel>(
 }
 
 /// As [`simulate_observed`], writing the samples into `buffer`'s memory.
-pub fn simulate_observed_reusing<M: CableModel>(
-    sys: &mut ClosedLoop<M>,
+pub fn simulate_observed_reusing<M: CableModel<D>, const D: usize>(
+    sys: &mut ClosedLoop<M, D>,
     opts: &RunOptions,
     buffer: SeriesBuffer,
     observer: &mut Observer,
@@ -274,8 +317,8 @@ pub fn simulate_observed_reusing<M: CableModel>(
 
 /// As [`simulate`], writing the samples into `buffer`'s memory (from [`TimeSeries::into_buffer`]
 /// of an earlier run): sweeps and benches then allocate their output once.
-pub fn simulate_reusing<M: CableModel>(
-    sys: &mut ClosedLoop<M>,
+pub fn simulate_reusing<M: CableModel<D>, const D: usize>(
+    sys: &mut ClosedLoop<M, D>,
     opts: &RunOptions,
     buffer: SeriesBuffer,
     progress: &mut dyn FnMut(f64),
@@ -293,8 +336,8 @@ pub fn simulate_reusing<M: CableModel>(
 
 /// As [`simulate`], from a given closed-loop state `y0` at t = 0 (`equilibrium` is reported as the
 /// run's starting point).
-pub fn simulate_from<M: CableModel>(
-    sys: &mut ClosedLoop<M>,
+pub fn simulate_from<M: CableModel<D>, const D: usize>(
+    sys: &mut ClosedLoop<M, D>,
     y0: Vec<f64>,
     equilibrium: Equilibrium,
     opts: &RunOptions,
@@ -310,8 +353,8 @@ pub fn simulate_from<M: CableModel>(
     )
 }
 
-fn integrate_and_sample<M: CableModel>(
-    sys: &mut ClosedLoop<M>,
+fn integrate_and_sample<M: CableModel<D>, const D: usize>(
+    sys: &mut ClosedLoop<M, D>,
     y0: Vec<f64>,
     equilibrium: Equilibrium,
     opts: &RunOptions,
@@ -336,7 +379,7 @@ fn integrate_and_sample<M: CableModel>(
     let mut events = Vec::new();
     let mut dopri;
     let mut alpha;
-    let stepper: &mut dyn Stepper<ClosedLoop<M>> = match opts.integrator {
+    let stepper: &mut dyn Stepper<ClosedLoop<M, D>> = match opts.integrator {
         IntegratorKind::Dopri5 => {
             dopri = Dopri5::new(
                 y0.len(),
@@ -401,11 +444,11 @@ fn integrate_and_sample<M: CableModel>(
 }
 
 /// The integration loop: accepted steps, located model events, samples, slack checks.
-fn integrate<M: CableModel>(
-    sys: &mut ClosedLoop<M>,
+fn integrate<M: CableModel<D>, const D: usize>(
+    sys: &mut ClosedLoop<M, D>,
     y0: &[f64],
     t_end: f64,
-    stepper: &mut dyn Stepper<ClosedLoop<M>>,
+    stepper: &mut dyn Stepper<ClosedLoop<M, D>>,
     sampler: &mut Sampler,
     events: &mut Vec<ModelEvent>,
     observer: &mut Observer,
@@ -430,7 +473,7 @@ fn integrate<M: CableModel>(
             let t = stepper.time();
             sampler.sample_through(sys, stepper, t)?;
             observer.emit(&sampler.series, taken, &mut row);
-            check_slack(t, sys.command(t, stepper.state()).tensions)?;
+            check_slack(t, &sys.command(t, stepper.state()).tensions)?;
             monitor.accept(sys, stepper.state());
             (observer.progress)(t / t_end);
             continue;
@@ -446,7 +489,7 @@ fn integrate<M: CableModel>(
         sampler.event_energy += event.energy_change;
         events.push(event);
         stepper.restart(sys, t_event, &y);
-        check_slack(t_event, sys.command(t_event, &y).tensions)?;
+        check_slack(t_event, &sys.command(t_event, &y).tensions)?;
         monitor.accept(sys, &y);
     }
     Ok(())
@@ -466,7 +509,7 @@ struct EventMonitor {
 pub const EVENT_TIME_TOL: f64 = 1e-12;
 
 impl EventMonitor {
-    fn new<M: CableModel>(sys: &ClosedLoop<M>, y: &[f64]) -> Self {
+    fn new<M: CableModel<D>, const D: usize>(sys: &ClosedLoop<M, D>, y: &[f64]) -> Self {
         let k = sys.model.event_count();
         let mut monitor = Self {
             before: vec![0.0; k],
@@ -479,7 +522,7 @@ impl EventMonitor {
     }
 
     /// Takes `y` as the start of the next step.
-    fn accept<M: CableModel>(&mut self, sys: &ClosedLoop<M>, y: &[f64]) {
+    fn accept<M: CableModel<D>, const D: usize>(&mut self, sys: &ClosedLoop<M, D>, y: &[f64]) {
         if !self.before.is_empty() {
             sys.model
                 .event_functions(&y[..sys.model_len()], &mut self.before);
@@ -488,10 +531,10 @@ impl EventMonitor {
 
     /// The earliest event function that fell from > 0 to ≤ 0 over the last accepted step, with
     /// the first time at which it is ≤ 0 (to within [`EVENT_TIME_TOL`]).
-    fn earliest_crossing<M: CableModel>(
+    fn earliest_crossing<M: CableModel<D>, const D: usize>(
         &mut self,
-        sys: &ClosedLoop<M>,
-        stepper: &dyn Stepper<ClosedLoop<M>>,
+        sys: &ClosedLoop<M, D>,
+        stepper: &dyn Stepper<ClosedLoop<M, D>>,
     ) -> Option<(usize, f64)> {
         if self.before.is_empty() {
             return None;
@@ -526,18 +569,17 @@ impl EventMonitor {
     }
 }
 
-/// A commanded tension ≤ 0 (or NaN) is a slack cable.
+/// A commanded tension ≤ 0 (or NaN) is a slack cable (the first such cable is named).
 #[inline]
-fn check_slack(t: f64, tensions: [f64; 2]) -> Result<(), RunError> {
-    if tensions[0] > 0.0 && tensions[1] > 0.0 {
-        return Ok(());
+fn check_slack(t: f64, tensions: &Tensions) -> Result<(), RunError> {
+    match tensions.iter().position(|&t| t <= 0.0 || t.is_nan()) {
+        None => Ok(()),
+        Some(i) => Err(RunError::SlackCable {
+            t,
+            cable: CableId(i),
+            tension: tensions[i],
+        }),
     }
-    let cable = if tensions[0] > 0.0 { 2 } else { 1 };
-    Err(RunError::SlackCable {
-        t,
-        cable,
-        tension: tensions[cable - 1],
-    })
 }
 
 /// Samples the dense output on the grid t_k = k·Δt (computed, not accumulated, so the grid is
@@ -559,10 +601,10 @@ struct Sampler {
 
 impl Sampler {
     /// Appends every grid sample with t_k ≤ `t` (within the last accepted step).
-    fn sample_through<M: CableModel>(
+    fn sample_through<M: CableModel<D>, const D: usize>(
         &mut self,
-        sys: &ClosedLoop<M>,
-        stepper: &dyn Stepper<ClosedLoop<M>>,
+        sys: &ClosedLoop<M, D>,
+        stepper: &dyn Stepper<ClosedLoop<M, D>>,
         t: f64,
     ) -> Result<(), RunError> {
         let n = sys.model_len();
@@ -585,16 +627,13 @@ impl Sampler {
             }
             let y = &self.y;
             let cmd = sys.command(tk, y);
-            check_slack(tk, cmd.tensions)?;
+            check_slack(tk, &cmd.tensions)?;
             let model_state = &y[..n];
             let eff = sys.model.effector(model_state);
-            let (x, z, d) = (eff.position.x, eff.position.y, sys.anchor_distance);
-            if !(x > 0.0 && x < d && z < 0.0) {
+            if !sys.robot().in_workspace(&eff.position) {
                 return Err(RunError::Workspace {
                     t: tk,
-                    x,
-                    z,
-                    anchor_distance: d,
+                    position: eff.position.as_slice().to_vec(),
                 });
             }
             let energy = sys.model.energy(model_state);
@@ -602,20 +641,17 @@ impl Sampler {
             let (work, dissipated) = (y[c], y[c + 1]);
             let residual = energy.total() - self.energy0 - work + dissipated - self.event_energy;
             let m = self.model_channels;
+            let cables = cmd.tensions.len();
             self.series.push_row_with(|row| {
-                let (common, rest) = row.split_at_mut(Channel::COMMON.len());
+                let (common, rest) = row.split_at_mut(4 + D + cables);
                 let (own, energies) = rest.split_at_mut(m);
-                common.copy_from_slice(&[
-                    tk,
-                    cmd.reference,
-                    eff.position.x,
-                    eff.position.y,
-                    cmd.error,
-                    cmd.force,
-                    cmd.tensions[0],
-                    cmd.tensions[1],
-                ]);
-                sys.model.channels(model_state, cmd.tensions, own);
+                common[0] = tk;
+                common[1] = cmd.reference;
+                common[2..2 + D].copy_from_slice(eff.position.as_slice());
+                common[2 + D] = cmd.error;
+                common[3 + D] = cmd.force;
+                common[4 + D..].copy_from_slice(&cmd.tensions);
+                sys.model.channels(model_state, &cmd.tensions, own);
                 energies.copy_from_slice(&[
                     energy.kinetic,
                     energy.elastic,

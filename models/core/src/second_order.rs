@@ -14,10 +14,8 @@ use cdpr_numerics::norms::max_abs;
 pub trait SecondOrderForm {
     /// Number n of generalised coordinates.
     fn dofs(&self) -> usize;
-    /// Index of the effector's x among q.
-    fn effector_x(&self) -> usize;
-    /// Index of the effector's z among q.
-    fn effector_z(&self) -> usize;
+    /// Index among q of the effector's coordinate along axis k (0: x, the last: z).
+    fn effector_coordinate(&self, k: usize) -> usize;
     /// Rows of R in which a commanded tension may appear (the closed loop couples them to the
     /// effector's coordinates the controller measures).
     fn tension_rows(&self) -> Vec<usize>;
@@ -46,7 +44,7 @@ pub trait SecondOrderForm {
     }
 
     /// R = M(q) q'' − F(q, q', T) for state `[q | q']` into `r` (n).
-    fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]);
+    fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: &[f64], r: &mut [f64]);
     /// S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q at fixed tensions, in the order of
     /// [`Self::iteration_pattern`]. Returns the residual evaluations it made and its refresh
     /// price ([`MatrixCost`]).
@@ -55,7 +53,7 @@ pub trait SecondOrderForm {
         &mut self,
         state: &[f64],
         qdd: &[f64],
-        tensions: [f64; 2],
+        tensions: &[f64],
         c_v: f64,
         c_q: f64,
         values: &mut [f64],

@@ -102,7 +102,7 @@ impl TimeSeries {
 
     /// Index of `channel`, if the run has it.
     pub fn index(&self, channel: Channel) -> Option<usize> {
-        self.index_named(channel.name())
+        self.index_named(&channel.name())
     }
 
     /// Index of the channel called `name` (a model's own channel).
@@ -113,7 +113,7 @@ impl TimeSeries {
     /// The samples of `channel`, if the run has it (every run has [`Channel::COMMON`] and
     /// [`Channel::ENERGY`]; the massive-cable models also [`Channel::CABLE`]).
     pub fn channel(&self, channel: Channel) -> Option<&[f64]> {
-        self.channel_named(channel.name())
+        self.channel_named(&channel.name())
     }
 
     /// The samples of the channel called `name` (a model's own channel), if there is one.

@@ -1,43 +1,35 @@
 //! # cdpr-elastic: massless elastic cables (paper §2.1, MODELS.md §3)
 //!
-//! Each cable is a massless spring from its pulley A_i to the effector C, tensioned by an ideal
+//! Each cable is a massless spring from its anchor A_i to the effector C, tensioned by an ideal
 //! tension-controlled winch: the effector feels exactly the commanded tension along the cable
 //! (eq. 2–3), and eq. 1 tells how much unstrained cable is paid out, l0_i = l_i / (1 + T_i/EA).
+//! The robot's space is the type parameter D (the paper's plane: D = 2) and its cables any
+//! number m of the robot's.
 //!
-//! State: (x, z, ẋ, ż) of the effector [m, m/s].
+//! State: the effector's position and velocity, (p, ṗ) [m, m/s] (the plane: (x, z, ẋ, ż)).
 
-use cdpr_core::controller::split_tensions;
 use cdpr_core::modal_layout::{Dof, ModalLayout};
-use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError, ModelParams};
+use cdpr_core::model::{
+    CableModel, Energy, Equilibrium, ModelError, ModelParams, RestRule, check_effector_x,
+};
+use cdpr_core::robot::{Effector, PerCable, Robot, Vector, along_vertical};
 use cdpr_core::scenario::{IntegratorKind, Scenario, ScenarioError, out_of_range};
 use cdpr_numerics::newton::{self, NewtonOptions, StaticProblem};
-use nalgebra::Vector2;
 
-/// The two-cable robot with massless elastic cables.
+/// A robot with massless elastic cables.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Elastic {
-    /// Pulley distance d [m]: A1 = (0, 0), A2 = (d, 0).
-    pub anchor_distance: f64,
-    /// Effector mass M [kg].
-    pub effector_mass: f64,
-    /// Gravity g [m/s²] along −z.
-    pub gravity: f64,
+pub struct Elastic<const D: usize> {
+    pub robot: Robot<D>,
     /// Axial stiffness EA [N] (eq. 1; it sets only the paid-out unstrained length).
     pub axial_stiffness: f64,
 }
-
-/// Indices of the state vector.
-const X: usize = 0;
-const Z: usize = 1;
-const VX: usize = 2;
-const VZ: usize = 3;
 
 /// The elastic model has no keys of its own in the `[model]` section, and stores no cable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub struct Params {}
 
 impl ModelParams for Params {
-    type Model = Elastic;
+    type Model = Elastic<2>;
     /// The massless cables have no second-order form, so no implicit path: refused here rather
     /// than when the run starts.
     fn validate(&self, scenario: &Scenario) -> Result<(), ScenarioError> {
@@ -51,73 +43,65 @@ impl ModelParams for Params {
         }
         Ok(())
     }
-    fn build(&self, scenario: &Scenario) -> Result<Elastic, ModelError> {
-        Ok(Elastic::new(scenario))
+    fn build(&self, scenario: &Scenario) -> Result<Elastic<2>, ModelError> {
+        Ok(Elastic::from_scenario(scenario))
     }
 }
 
-impl Elastic {
-    /// The model with the scenario's robot and cable.
-    pub fn new(scenario: &Scenario) -> Self {
+impl<const D: usize> Elastic<D> {
+    /// The model of `robot` with cables of axial stiffness EA [N].
+    pub fn new(robot: Robot<D>, axial_stiffness: f64) -> Self {
         Self {
-            anchor_distance: scenario.robot.anchor_distance,
-            effector_mass: scenario.robot.effector_mass,
-            gravity: scenario.robot.gravity,
-            axial_stiffness: scenario.cable.axial_stiffness(),
+            robot,
+            axial_stiffness,
         }
     }
 
-    /// Pulley points A1, A2 [m].
-    pub fn pulleys(&self) -> [Vector2<f64>; 2] {
-        [
-            Vector2::new(0.0, 0.0),
-            Vector2::new(self.anchor_distance, 0.0),
-        ]
-    }
-
-    /// Cable lengths l_i = |A_i − C| [m] and unit vectors e_i = (A_i − C)/l_i (eq. 3).
-    pub fn cables(&self, effector: Vector2<f64>) -> [(f64, Vector2<f64>); 2] {
-        self.pulleys().map(|a| {
-            let chord = a - effector;
-            let l = chord.norm();
-            (l, chord / l)
-        })
-    }
-
-    /// Net force on the effector [N]: T1 e1 + T2 e2 + M g (eq. 2 times M; zero is eq. 14).
-    pub fn net_force(&self, effector: Vector2<f64>, tensions: [f64; 2]) -> Vector2<f64> {
-        let [(_, e1), (_, e2)] = self.cables(effector);
-        e1 * tensions[0] + e2 * tensions[1] - Vector2::new(0.0, self.effector_mass * self.gravity)
+    /// Net force on the effector [N]: Σ T_i e_i + M g⃗ (eq. 2 times M; zero is eq. 14).
+    pub fn net_force(&self, effector: &Vector<D>, tensions: &[f64]) -> Vector<D> {
+        let r = &self.robot;
+        r.structure_matrix(effector).force(tensions)
+            - along_vertical::<D>(r.effector_mass * r.gravity)
     }
 
     /// Unstrained paid-out length of each cable, eq. 1 inverted: l0 = l/(1 + T/EA) [m].
-    pub fn unstrained_lengths(&self, effector: Vector2<f64>, tensions: [f64; 2]) -> [f64; 2] {
-        let [(l1, _), (l2, _)] = self.cables(effector);
-        [
-            l1 / (1.0 + tensions[0] / self.axial_stiffness),
-            l2 / (1.0 + tensions[1] / self.axial_stiffness),
-        ]
+    pub fn unstrained_lengths(&self, effector: &Vector<D>, tensions: &[f64]) -> PerCable {
+        PerCable::from_fn(self.robot.cables(), |i| {
+            self.robot.chord(i, effector).length / (1.0 + tensions[i] / self.axial_stiffness)
+        })
+    }
+
+    /// Linearised vertical frequency at a static state with the tensions held fixed (geometric
+    /// stiffness, MODELS.md §3): ω² = Σ T_i |u_i,horizontal|² / (M l_i) [rad/s].
+    pub fn vertical_frequency(&self, effector: &Vector<D>, tensions: &[f64]) -> f64 {
+        let stiffness: f64 = (0..self.robot.cables())
+            .map(|i| {
+                let c = self.robot.chord(i, effector);
+                (0..D - 1)
+                    .map(|k| tensions[i] * c.direction[k] * c.direction[k] / c.length)
+                    .sum::<f64>()
+            })
+            .sum();
+        (stiffness / self.robot.effector_mass).sqrt()
+    }
+}
+
+impl Elastic<2> {
+    /// The planar robot of `scenario` (its `[robot]` and `[cable]` sections).
+    pub fn from_scenario(scenario: &Scenario) -> Self {
+        Self::new(scenario.robot(), scenario.cable.axial_stiffness())
     }
 
     /// Symmetric closed form of eq. 14 for the effector at mid-span with ΣT/2 in each cable:
     /// z0 = −(d/2)·tan(asin(M g/ΣT)) [m] (MODELS.md §2: −0.0245546 m for the paper).
     pub fn midspan_sag(&self, tension_sum: f64) -> f64 {
-        -0.5 * self.anchor_distance
-            * (self.effector_mass * self.gravity / tension_sum)
-                .asin()
-                .tan()
+        let r = &self.robot;
+        -0.5 * self.anchor_distance() * (r.effector_mass * r.gravity / tension_sum).asin().tan()
     }
 
-    /// Linearised vertical frequency at a static state with the tensions held fixed (geometric
-    /// stiffness, MODELS.md §3): ω² = Σ T_i cos²θ_i / (M l_i) [rad/s].
-    pub fn vertical_frequency(&self, effector: Vector2<f64>, tensions: [f64; 2]) -> f64 {
-        let stiffness: f64 = self
-            .cables(effector)
-            .iter()
-            .zip(tensions)
-            .map(|(&(l, e), t)| t * e.x * e.x / l)
-            .sum();
-        (stiffness / self.effector_mass).sqrt()
+    /// The distance d between the plane's two pulleys [m].
+    pub fn anchor_distance(&self) -> f64 {
+        self.robot.anchor(1)[0] - self.robot.anchor(0)[0]
     }
 }
 
@@ -127,164 +111,227 @@ pub fn eq15_frequency(tension: f64, effector_mass: f64, x: f64, anchor_distance:
     (tension / effector_mass * (1.0 / x + 1.0 / (anchor_distance - x))).sqrt()
 }
 
-/// Eq. 14 with x fixed: unknowns (z [m], F0 [N]), residual the net force on the effector.
-struct Eq14<'a> {
-    model: &'a Elastic,
-    x: f64,
-    tension_sum: f64,
+/// Eq. 14 under a rest rule: unknowns the effector's coordinates the rule leaves free (in axis
+/// order) [m] and the rule's parameters, residual the net force on the effector.
+struct Eq14<'a, const D: usize> {
+    model: &'a Elastic<D>,
+    rule: &'a dyn RestRule<D>,
+    /// The axes the rule leaves free.
+    free: Vec<usize>,
 }
 
-impl StaticProblem for Eq14<'_> {
+impl<const D: usize> Eq14<'_, D> {
+    fn position(&self, u: &[f64]) -> Vector<D> {
+        let mut p = Vector::zeros();
+        for &(axis, value) in self.rule.pinned() {
+            p[axis] = value;
+        }
+        for (k, &axis) in self.free.iter().enumerate() {
+            p[axis] = u[k];
+        }
+        p
+    }
+}
+
+impl<const D: usize> StaticProblem for Eq14<'_, D> {
     fn dimension(&self) -> usize {
-        2
+        D
     }
     fn length_unknowns(&self) -> usize {
-        1
+        self.free.len()
     }
     fn residual(&mut self, u: &[f64], r: &mut [f64]) {
-        let tensions = split_tensions(self.tension_sum, u[1]);
-        let f = self.model.net_force(Vector2::new(self.x, u[0]), tensions);
-        r[0] = f.x;
-        r[1] = f.y;
+        let tensions = self.rule.tensions(&u[self.free.len()..]);
+        let f = self.model.net_force(&self.position(u), &tensions);
+        r.copy_from_slice(f.as_slice());
     }
     fn scale(&self, i: usize) -> f64 {
-        [1e-2, 1.0][i]
+        match i.checked_sub(self.free.len()) {
+            None => 1e-2,
+            // The paper's rule: F0, of order 1 N (a share of ΣT that vanishes at mid-span).
+            Some(_) => 1.0,
+        }
     }
 }
 
-impl CableModel for Elastic {
+impl<const D: usize> CableModel<D> for Elastic<D> {
     fn name(&self) -> &'static str {
         "elastic"
+    }
+
+    fn robot(&self) -> &Robot<D> {
+        &self.robot
     }
 
     /// One group: the effector, which is all the model's coordinates.
     fn modal_layout(&self, _state: &[f64]) -> ModalLayout {
         ModalLayout {
             dofs: vec![Dof::Effector {
-                x: X,
-                z: Z,
-                mass: self.effector_mass,
+                coordinates: (0..D).collect(),
+                mass: self.robot.effector_mass,
             }],
             frozen: Vec::new(),
         }
     }
 
     fn state_len(&self) -> usize {
-        4
+        2 * D
     }
 
-    fn equilibrium(
-        &mut self,
-        effector_x: f64,
-        tension_sum: f64,
-    ) -> Result<Equilibrium, ModelError> {
-        cdpr_core::model::check_effector_x(effector_x, self.anchor_distance)?;
-        let d = self.anchor_distance;
-        if self.effector_mass * self.gravity >= tension_sum {
+    fn equilibrium(&mut self, rule: &dyn RestRule<D>) -> Result<Equilibrium, ModelError> {
+        let pinned = rule.pinned();
+        let free: Vec<usize> = (0..D)
+            .filter(|k| pinned.iter().all(|(axis, _)| axis != k))
+            .collect();
+        if free.len() + pinned.len() != D {
             return Err(ModelError::Parameter {
-                name: "tension_sum",
-                value: tension_sum,
-                allowed: format!("> M g = {} N", self.effector_mass * self.gravity),
+                name: "rest rule",
+                value: pinned.len() as f64,
+                allowed: format!("as many parameters as pinned coordinates, of {D}"),
             });
         }
-        // Small-sag start (string with tension ΣT/2 deflected by M g at x): within a few percent of
-        // the solution anywhere in the workspace, where the mid-span sag is not near the pulleys.
-        let sag = -self.effector_mass * self.gravity * effector_x * (d - effector_x)
-            / (0.5 * tension_sum * d);
-        let mut unknowns = [sag, 0.0];
+        let r = &self.robot;
+        let weight = r.effector_mass * r.gravity;
+        let mut unknowns = vec![0.0; D];
+        if D == 2 && pinned.len() == 1 && pinned[0].0 == 0 {
+            // The plane's rule: x pinned, (z, F0) unknown. Small-sag start (a string with ΣT/2
+            // deflected by M g at x): within a few percent of the solution in the workspace.
+            let x = pinned[0].1;
+            let tension_sum = rule.tensions(&[0.0]).iter().sum::<f64>();
+            let (a, d) = (r.anchor(0)[0], r.anchor(1)[0] - r.anchor(0)[0]);
+            check_effector_x(x - a, d)?;
+            if weight >= tension_sum {
+                return Err(ModelError::Parameter {
+                    name: "tension_sum",
+                    value: tension_sum,
+                    allowed: format!("> M g = {weight} N"),
+                });
+            }
+            unknowns[0] = -weight * (x - a) * (d - (x - a)) / (0.5 * tension_sum * d);
+        } else {
+            // Elsewhere: the anchors' centroid, one chord length below the lowest.
+            let centroid = r.anchors().iter().sum::<Vector<D>>() / r.cables() as f64;
+            for (k, &axis) in free.iter().enumerate() {
+                unknowns[k] = centroid[axis];
+            }
+        }
         let mut problem = Eq14 {
             model: self,
-            x: effector_x,
-            tension_sum,
+            rule,
+            free,
         };
         let report = newton::solve(&mut problem, &mut unknowns, NewtonOptions::default())?;
+        let p = problem.position(&unknowns);
+        let parameters = unknowns[problem.free.len()..].to_vec();
+        let mut state = vec![0.0; 2 * D];
+        state[..D].copy_from_slice(p.as_slice());
         Ok(Equilibrium {
-            state: vec![effector_x, unknowns[0], 0.0, 0.0],
-            force: unknowns[1],
+            state,
+            tensions: rule.tensions(&parameters),
+            parameters,
             iterations: report.iterations,
             residual: report.residual,
         })
     }
 
-    fn rhs(&mut self, _t: f64, y: &[f64], tensions: [f64; 2], rate: &mut [f64]) {
-        let acc = self.net_force(Vector2::new(y[X], y[Z]), tensions) / self.effector_mass;
-        rate[X] = y[VX];
-        rate[Z] = y[VZ];
-        rate[VX] = acc.x;
-        rate[VZ] = acc.y;
+    fn rhs(&mut self, _t: f64, y: &[f64], tensions: &[f64], rate: &mut [f64]) {
+        let p = Vector::<D>::from_column_slice(&y[..D]);
+        let acc = self.net_force(&p, tensions) / self.robot.effector_mass;
+        rate[..D].copy_from_slice(&y[D..]);
+        rate[D..].copy_from_slice(acc.as_slice());
     }
 
-    fn effector(&self, y: &[f64]) -> Effector {
+    fn effector(&self, y: &[f64]) -> Effector<D> {
         Effector {
-            position: Vector2::new(y[X], y[Z]),
-            velocity: Vector2::new(y[VX], y[VZ]),
+            position: Vector::from_column_slice(&y[..D]),
+            velocity: Vector::from_column_slice(&y[D..2 * D]),
         }
     }
 
     /// Reeling-in rate = −dl_i/dt = e_i·v: the reel takes in what the effector's approach frees.
-    fn reel_speeds(&self, y: &[f64]) -> [f64; 2] {
-        let v = Vector2::new(y[VX], y[VZ]);
-        self.cables(Vector2::new(y[X], y[Z]))
-            .map(|(_, e)| e.dot(&v))
+    fn reel_speeds(&self, y: &[f64]) -> PerCable {
+        let e = self.effector(y);
+        let w = self.robot.structure_matrix(&e.position);
+        PerCable::from_fn(self.robot.cables(), |i| w.column(i).dot(&e.velocity))
     }
 
     /// Kinetic and gravity energy of the effector; massless cables carry no kinetic energy and,
     /// between ideal tension-controlled winches, their strain energy is not part of the effector's
     /// balance: d/dt(½M|v|² + M g z) = Σ T_i e_i·v, the reels' power (MODELS.md §3).
     fn energy(&self, y: &[f64]) -> Energy {
+        let r = &self.robot;
+        let v = &y[D..2 * D];
+        let mut speed2 = v[0] * v[0];
+        for vk in &v[1..] {
+            speed2 += vk * vk;
+        }
         Energy {
-            kinetic: 0.5 * self.effector_mass * (y[VX] * y[VX] + y[VZ] * y[VZ]),
+            kinetic: 0.5 * r.effector_mass * speed2,
             elastic: 0.0,
-            gravity: self.effector_mass * self.gravity * y[Z],
+            gravity: r.effector_mass * r.gravity * y[D - 1],
         }
     }
 
     /// Strained lengths l_i and unstrained lengths l0_i (eq. 1) [m]. A massless cable carries the
     /// commanded tension to the effector unchanged, so no separate effector-end tension is stored.
     fn channel_names(&self) -> Vec<String> {
-        ["l1", "l2", "l0_1", "l0_2"].map(String::from).to_vec()
+        let m = self.robot.cables();
+        (1..=m)
+            .map(|i| format!("l{i}"))
+            .chain((1..=m).map(|i| format!("l0_{i}")))
+            .collect()
     }
 
     fn channel_units(&self) -> Vec<&'static str> {
-        vec!["m"; 4]
+        vec!["m"; 2 * self.robot.cables()]
     }
 
-    fn channels(&self, y: &[f64], tensions: [f64; 2], out: &mut [f64]) {
-        let [(l1, _), (l2, _)] = self.cables(Vector2::new(y[X], y[Z]));
-        let ea = self.axial_stiffness;
-        out.copy_from_slice(&[
-            l1,
-            l2,
-            l1 / (1.0 + tensions[0] / ea),
-            l2 / (1.0 + tensions[1] / ea),
-        ]);
+    fn channels(&self, y: &[f64], tensions: &[f64], out: &mut [f64]) {
+        let p = Vector::<D>::from_column_slice(&y[..D]);
+        let (m, ea) = (self.robot.cables(), self.axial_stiffness);
+        for i in 0..m {
+            let l = self.robot.chord(i, &p).length;
+            out[i] = l;
+            out[m + i] = l / (1.0 + tensions[i] / ea);
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use cdpr_core::model::SplitRule;
+
+    fn paper() -> Elastic<2> {
+        let s = Scenario::paper();
+        Elastic::new(s.robot(), s.cable.axial_stiffness())
+    }
 
     #[test]
     fn paper_equilibrium_matches_the_closed_form() {
-        let mut m = Elastic::new(&Scenario::paper());
-        let eq = m.equilibrium(0.5, 200.0).unwrap();
+        let mut m = paper();
+        let eq = m.equilibrium(&SplitRule::new(0.5, 200.0)).unwrap();
         // Symmetric start: F0 = 0 and z0 the closed form (MODELS.md §2: −0.0245546 m).
         assert!((eq.state[1] - m.midspan_sag(200.0)).abs() < 1e-12);
         assert!((eq.state[1] + 0.0245546).abs() < 1e-7);
-        assert!(eq.force.abs() < 1e-9);
+        assert!(eq.parameters[0].abs() < 1e-9);
     }
 
     #[test]
     fn frequencies_at_the_end_position() {
         // MODELS.md §3 at x = 0.6: eq. 15 = 20.4124, geometric 20.3721 rad/s; MODELS.md FE.8.3:
         // massless z_P = −0.023573508 m, F0 = 0.096236 N.
-        let mut m = Elastic::new(&Scenario::paper());
-        let eq = m.equilibrium(0.6, 200.0).unwrap();
+        let mut m = paper();
+        let eq = m.equilibrium(&SplitRule::new(0.6, 200.0)).unwrap();
         assert!((eq.state[1] + 0.023573508).abs() < 1e-9, "{}", eq.state[1]);
-        assert!((eq.force - 0.096236).abs() < 1e-6, "{}", eq.force);
-        let t = [0.5 * (200.0 - eq.force), 0.5 * (200.0 + eq.force)];
-        let w = m.vertical_frequency(Vector2::new(0.6, eq.state[1]), t);
+        assert!(
+            (eq.parameters[0] - 0.096236).abs() < 1e-6,
+            "{}",
+            eq.parameters[0]
+        );
+        let f0 = eq.parameters[0];
+        let t = [0.5 * (200.0 - f0), 0.5 * (200.0 + f0)];
+        let w = m.vertical_frequency(&nalgebra::Vector2::new(0.6, eq.state[1]), &t);
         assert!((w - 20.3721).abs() < 1e-4, "{w}");
         assert!((eq15_frequency(100.0, 1.0, 0.6, 1.0) - 20.4124).abs() < 1e-4);
     }

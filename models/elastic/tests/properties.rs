@@ -3,7 +3,8 @@
 
 use cdpr_core::channel::Channel;
 use cdpr_core::closed_loop::{Actuation, ClosedLoop};
-use cdpr_core::model::CableModel;
+use cdpr_core::model::{CableModel, SplitRule};
+use cdpr_core::robot::Tensions;
 use cdpr_core::runner::{RunOptions, simulate_from};
 use cdpr_core::scenario::Scenario;
 use cdpr_elastic::{Elastic, eq15_frequency};
@@ -11,12 +12,12 @@ use cdpr_numerics::Dopri5Options;
 use nalgebra::Vector2;
 use proptest::prelude::*;
 
-fn model(d: f64, mass: f64, g: f64) -> Elastic {
+fn model(d: f64, mass: f64, g: f64) -> Elastic<2> {
     let mut s = Scenario::paper();
     s.robot.anchor_distance = d;
     s.robot.effector_mass = mass;
     s.robot.gravity = g;
-    Elastic::new(&s)
+    Elastic::from_scenario(&s)
 }
 
 proptest! {
@@ -36,17 +37,17 @@ proptest! {
         let tension_sum = margin * mass * g;
         let mut m = model(d, mass, g);
         let x = frac * d;
-        let eq = m.equilibrium(x, tension_sum).unwrap();
+        let eq = m.equilibrium(&SplitRule::new(x, tension_sum)).unwrap();
         let z = eq.state[1];
         prop_assert!(z < 0.0, "the effector hangs below the pulleys");
-        let (t1, t2) = (0.5 * (tension_sum - eq.force), 0.5 * (tension_sum + eq.force));
+        let (t1, t2) = (0.5 * (tension_sum - eq.force()), 0.5 * (tension_sum + eq.force()));
         let (l1, l2) = (x.hypot(z), (d - x).hypot(z));
         let fx = t1 * (-x) / l1 + t2 * (d - x) / l2;
         let fz = t1 * (-z) / l1 + t2 * (-z) / l2 - mass * g;
         prop_assert!(fx.abs() < 1e-7 && fz.abs() < 1e-7, "residual ({fx:e}, {fz:e}) N");
         // Symmetry: the mirrored position needs the mirrored force.
-        let mirror = m.equilibrium(d - x, tension_sum).unwrap();
-        prop_assert!((mirror.force + eq.force).abs() < 1e-9 * tension_sum);
+        let mirror = m.equilibrium(&SplitRule::new(d - x, tension_sum)).unwrap();
+        prop_assert!((mirror.force() + eq.force()).abs() < 1e-9 * tension_sum);
         prop_assert!((mirror.state[1] - z).abs() < 1e-12);
     }
 
@@ -64,9 +65,9 @@ proptest! {
         let g = sag_ratio * tension_sum / mass;
         let mut m = model(d, mass, g);
         let x = frac * d;
-        let eq = m.equilibrium(x, tension_sum).unwrap();
-        let tensions = [0.5 * (tension_sum - eq.force), 0.5 * (tension_sum + eq.force)];
-        let geometric = m.vertical_frequency(Vector2::new(x, eq.state[1]), tensions);
+        let eq = m.equilibrium(&SplitRule::new(x, tension_sum)).unwrap();
+        let tensions = Tensions::pair([0.5 * (tension_sum - eq.force()), 0.5 * (tension_sum + eq.force())]);
+        let geometric = m.vertical_frequency(&Vector2::new(x, eq.state[1]), &tensions);
         let eq15 = eq15_frequency(0.5 * tension_sum, mass, x, d);
         prop_assert!((geometric / eq15 - 1.0).abs() < 1e-5, "{geometric} vs {eq15}");
     }
@@ -92,19 +93,19 @@ proptest! {
         let g = tension_sum * sag_degrees.to_radians().sin() / mass;
         let mut m = model(d, mass, g);
         let x = frac * d;
-        let eq = m.equilibrium(x, tension_sum).unwrap();
+        let eq = m.equilibrium(&SplitRule::new(x, tension_sum)).unwrap();
         let z = eq.state[1];
-        let tensions = [0.5 * (tension_sum - eq.force), 0.5 * (tension_sum + eq.force)];
+        let tensions = Tensions::pair([0.5 * (tension_sum - eq.force()), 0.5 * (tension_sum + eq.force())]);
         let stiffness: f64 = [x, d - x]
             .into_iter()
-            .zip(tensions)
+            .zip(tensions.iter())
             .map(|(horizontal, t)| {
                 let theta = (-z).atan2(horizontal);
                 t * theta.cos().powi(2) / horizontal.hypot(z)
             })
             .sum();
         let expected = (stiffness / mass).sqrt();
-        let geometric = m.vertical_frequency(Vector2::new(x, z), tensions);
+        let geometric = m.vertical_frequency(&Vector2::new(x, z), &tensions);
         prop_assert!((geometric / expected - 1.0).abs() < 1e-12, "{geometric} vs {expected}");
         prop_assert!(-z / x.min(d - x) > 0.035, "the sag is finite: z = {z}");
     }
@@ -127,11 +128,11 @@ proptest! {
         vz in -0.05f64..0.05,
     ) {
         let scenario = Scenario::paper();
-        let mut m = Elastic::new(&scenario);
+        let mut m = Elastic::from_scenario(&scenario);
         let x = frac * scenario.robot.anchor_distance;
-        let eq = m.equilibrium(x, tension_sum).unwrap();
-        let tensions = [0.5 * (tension_sum - eq.force), 0.5 * (tension_sum + eq.force)];
-        let mut sys = ClosedLoop::new(m, &scenario);
+        let eq = m.equilibrium(&SplitRule::new(x, tension_sum)).unwrap();
+        let tensions = Tensions::pair([0.5 * (tension_sum - eq.force()), 0.5 * (tension_sum + eq.force())]);
+        let mut sys = ClosedLoop::new(m, &scenario).unwrap();
         sys.actuation = Actuation::Prescribed(Box::new(move |_| tensions));
         let y0 = vec![x + dx, eq.state[1] + dz, vx, vz, 0.0, 0.0, 0.0, 0.0];
         let opts = RunOptions::dopri5(1.0, 1e-3, Dopri5Options { rtol: 1e-10, atol: 1e-12, ..Dopri5Options::default() });
@@ -164,12 +165,12 @@ proptest! {
 /// central differences along a uniform motion, to 1e-8 m/s (difference step 1e-6 s, O(h²) error).
 #[test]
 fn reel_speeds_are_the_shortening_rates() {
-    let m = Elastic::new(&Scenario::paper());
+    let m = Elastic::from_scenario(&Scenario::paper());
     let y = [0.37, -0.08, 0.4, -0.3];
     let h = 1e-6;
     let lengths = |t: f64| {
-        m.cables(Vector2::new(y[0] + y[2] * t, y[1] + y[3] * t))
-            .map(|(l, _)| l)
+        let p = Vector2::new(y[0] + y[2] * t, y[1] + y[3] * t);
+        [0, 1].map(|i| m.robot.chord(i, &p).length)
     };
     let (lp, lm) = (lengths(h), lengths(-h));
     let v = m.reel_speeds(&y);
@@ -204,10 +205,10 @@ proptest! {
         let ea = m.axial_stiffness;
         let p = Vector2::new(x, z);
         let lengths = [p.norm(), (p - Vector2::new(1.0, 0.0)).norm()];
-        let reported = m.unstrained_lengths(p, [t1, t2]);
+        let reported = m.unstrained_lengths(&p, &[t1, t2]);
         let mut channels = vec![0.0; 4];
         let y = [x, z, 0.0, 0.0];
-        m.channels(&y, [t1, t2], &mut channels);
+        m.channels(&y, &[t1, t2], &mut channels);
         for (k, t) in [t1, t2].into_iter().enumerate() {
             prop_assert!((channels[k] / lengths[k] - 1.0).abs() < 1e-15, "l{}", k + 1);
             for l0 in [reported[k], channels[2 + k]] {

@@ -271,12 +271,8 @@ impl SecondOrderForm for Fe {
         self.positions_len()
     }
 
-    fn effector_x(&self) -> usize {
-        self.effector_index()
-    }
-
-    fn effector_z(&self) -> usize {
-        self.effector_index() + self.chain_nodes()
+    fn effector_coordinate(&self, k: usize) -> usize {
+        self.effector_index() + k * self.chain_nodes()
     }
 
     /// T_i pulls the reel end (row ρ_i), or the rigid stored cable through l_i.
@@ -337,7 +333,8 @@ impl SecondOrderForm for Fe {
     /// clearing it and multiplying it out again is a second pass over every node that the
     /// residual does not need (FE implicit paper run 0.1436 → 0.1420 s). The rows collected
     /// before they are summed and the lanes took it from 0.124 to 0.097 s (docs/performance.md).
-    fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]) {
+    fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: &[f64], r: &mut [f64]) {
+        let tensions = [tensions[0], tensions[1]];
         let (n, nn, np) = (self.elements, self.chain_nodes(), self.positions_len());
         r.fill(0.0);
         let spans = [self.span_of(state, 0), self.span_of(state, 1)];
@@ -401,7 +398,7 @@ impl SecondOrderForm for Fe {
         &mut self,
         state: &[f64],
         qdd: &[f64],
-        _tensions: [f64; 2],
+        _tensions: &[f64],
         c_v: f64,
         c_q: f64,
         values: &mut [f64],

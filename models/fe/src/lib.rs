@@ -31,7 +31,8 @@ pub mod params;
 pub mod solve;
 mod statics;
 
-use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError};
+use cdpr_core::model::{CableModel, Energy, Equilibrium, ModelError, RestRule};
+use cdpr_core::robot::{Effector, PerCable, Robot};
 use cdpr_core::scenario::Scenario;
 use element::{Chord, ElementState, MassCoefficients, Material};
 use nalgebra::Vector2;
@@ -76,6 +77,8 @@ impl Span {
 pub struct Fe {
     /// Pulley distance d [m]: A1 = (0, 0), A2 = (d, 0).
     pub anchor_distance: f64,
+    /// The planar robot: pulleys A1 = (0, 0), A2 = (d, 0).
+    pub robot: Robot<2>,
     /// Effector mass M [kg].
     pub effector_mass: f64,
     /// Free-span elements per cable N.
@@ -142,6 +145,7 @@ impl Fe {
         };
         Ok(Self {
             anchor_distance: scenario.robot.anchor_distance,
+            robot: scenario.robot(),
             effector_mass: scenario.robot.effector_mass,
             elements: n,
             modelled_length: cable.modelled_length,
@@ -485,44 +489,44 @@ impl Fe {
     }
 }
 
-impl CableModel for Fe {
+impl CableModel<2> for Fe {
     fn name(&self) -> &'static str {
         "fe"
+    }
+
+    fn robot(&self) -> &Robot<2> {
+        &self.robot
     }
 
     fn state_len(&self) -> usize {
         2 * self.positions_len()
     }
 
-    fn equilibrium(
-        &mut self,
-        effector_x: f64,
-        tension_sum: f64,
-    ) -> Result<Equilibrium, ModelError> {
-        statics::equilibrium(self, effector_x, tension_sum)
+    fn equilibrium(&mut self, rule: &dyn RestRule<2>) -> Result<Equilibrium, ModelError> {
+        statics::equilibrium(self, rule)
     }
 
-    fn rhs(&mut self, _t: f64, y: &[f64], tensions: [f64; 2], rate: &mut [f64]) {
+    fn rhs(&mut self, _t: f64, y: &[f64], tensions: &[f64], rate: &mut [f64]) {
         let np = self.positions_len();
         let (dq, dv) = rate.split_at_mut(np);
         dq.copy_from_slice(&y[np..]);
-        if !self.accelerations(y, tensions, dv) {
+        if !self.accelerations(y, [tensions[0], tensions[1]], dv) {
             // M is not positive definite (an element or the stored cable collapsed): no motion is
             // defined; NaN makes the integrator stop with a non-finite state.
             dv.fill(f64::NAN);
         }
     }
 
-    fn effector(&self, y: &[f64]) -> Effector {
+    fn effector(&self, y: &[f64]) -> Effector<2> {
         let (position, velocity) = self.node(y, 0, self.elements);
         Effector { position, velocity }
     }
 
     /// dE/dt = Σ T_i ρ_i' (FE.7): the reel end moving away from the pulley takes cable in. Rigid
     /// stored cable: −l_i'.
-    fn reel_speeds(&self, y: &[f64]) -> [f64; 2] {
+    fn reel_speeds(&self, y: &[f64]) -> PerCable {
         let np = self.positions_len();
-        [0, 1].map(|c| match self.rho_index(c) {
+        PerCable::from_fn(2, |c| match self.rho_index(c) {
             Some(r) => y[np + r],
             None => -y[np + self.l_index(c)],
         })
@@ -579,19 +583,21 @@ impl CableModel for Fe {
     }
 
     fn channel_names(&self) -> Vec<String> {
-        cdpr_core::channel::Channel::CABLE
-            .map(|c| c.name().to_owned())
-            .to_vec()
+        cdpr_core::channel::Channel::cable_channels(2)
+            .into_iter()
+            .map(|c| c.name())
+            .collect()
     }
 
     fn channel_units(&self) -> Vec<&'static str> {
         use cdpr_core::channel::Channel;
-        Channel::CABLE
+        Channel::cable_channels(2)
+            .into_iter()
             .map(|c| match c {
                 Channel::Stored(_) => "m",
                 c => c.unit(),
             })
-            .to_vec()
+            .collect()
     }
 
     fn second_order(&self) -> Option<&dyn cdpr_core::second_order::SecondOrderForm> {
@@ -608,7 +614,7 @@ impl CableModel for Fe {
 
     /// Element tensions N_N (at the effector) and N_1 (at the pulley) [N], free unstrained lengths
     /// l_i [m], stored lengths ρ_i [m].
-    fn channels(&self, y: &[f64], _tensions: [f64; 2], out: &mut [f64]) {
+    fn channels(&self, y: &[f64], _tensions: &[f64], out: &mut [f64]) {
         let n = self.elements;
         // Elements N (at the effector) and 1 (at the pulley) of each cable, from one span each
         // (this runs per output sample); the same states as `element_tension`'s, bit for bit.
@@ -670,7 +676,7 @@ mod tests {
             }
             // The channels' end tensions, computed per span, are `element_tension`'s.
             let mut out = vec![0.0; fe.channel_names().len()];
-            fe.channels(&y, [100.0, 100.0], &mut out);
+            fe.channels(&y, &[100.0, 100.0], &mut out);
             let n = elements;
             let expected =
                 [(0, n), (1, n), (0, 1), (1, 1)].map(|(c, e)| fe.element_tension(&y, c, e).1);

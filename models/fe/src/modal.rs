@@ -13,8 +13,7 @@ impl Fe {
         let p = self.effector_index();
         let mut layout = ModalLayout {
             dofs: vec![Dof::Effector {
-                x: self.node_coordinate(p, 0),
-                z: self.node_coordinate(p, 1),
+                coordinates: vec![self.node_coordinate(p, 0), self.node_coordinate(p, 1)],
                 mass: self.effector_mass,
             }],
             frozen: Vec::new(),
@@ -26,11 +25,11 @@ impl Fe {
                 let j = self.chain_index(cable, k).expect("k ≥ 1 is a chain node");
                 let (prev, _) = self.node(y, cable, k - 1);
                 let (next, _) = self.node(y, cable, k + 1);
+                let tangent = (next - prev).normalize();
                 layout.dofs.push(Dof::Node {
                     cable,
-                    x: j,
-                    z: nn + j,
-                    tangent: (next - prev).normalize(),
+                    coordinates: vec![j, nn + j],
+                    tangent: vec![tangent.x, tangent.y],
                     mass: mu * l / n as f64,
                 });
             }

@@ -7,8 +7,7 @@
 //! continuous, so the solution is the discrete version of the continuum CDPR of FE.8.3.
 
 use crate::Fe;
-use cdpr_core::controller::split_tensions;
-use cdpr_core::model::{CableModel, Equilibrium, ModelError};
+use cdpr_core::model::{CableModel, Equilibrium, ModelError, RestRule};
 use cdpr_core::second_order::SecondOrderForm;
 use cdpr_core::statics;
 use cdpr_numerics::newton::{self, NewtonOptions, StaticProblem};
@@ -17,7 +16,7 @@ use nalgebra::Vector2;
 struct Problem<'a> {
     model: &'a mut Fe,
     effector_x: f64,
-    tension_sum: f64,
+    rule: &'a dyn RestRule<2>,
     /// State being assembled (velocities stay zero).
     y: Vec<f64>,
     /// Indices in q of the length unknowns, in order (F0 is the last unknown).
@@ -36,7 +35,8 @@ struct Problem<'a> {
 
 impl Problem<'_> {
     fn tensions(&self, force: f64) -> [f64; 2] {
-        split_tensions(self.tension_sum, force)
+        let t = self.rule.tensions(&[force]);
+        [t[0], t[1]]
     }
 
     fn load(&mut self, u: &[f64]) {
@@ -114,7 +114,7 @@ impl StaticProblem for Problem<'_> {
     /// ΣT for F0, on which the residual is linear.
     fn scale(&self, i: usize) -> f64 {
         if i == self.map.len() {
-            self.tension_sum
+            self.rule.scale(0)
         } else {
             1e-4
         }
@@ -124,28 +124,40 @@ impl StaticProblem for Problem<'_> {
 /// Equilibrium of MODELS.md §2 / FE.8.1 with the effector at x = `effector_x`.
 pub(crate) fn equilibrium(
     model: &mut Fe,
-    effector_x: f64,
-    tension_sum: f64,
+    rule: &dyn RestRule<2>,
 ) -> Result<Equilibrium, ModelError> {
-    let (mut problem, mut u) = problem(model, effector_x, tension_sum)?;
+    let (mut problem, mut u) = problem(model, rule)?;
     let report = newton::solve(&mut problem, &mut u, NewtonOptions::default())?;
     problem.load(&u);
     let force = u[problem.map.len()];
     debug_assert_eq!(problem.y.len(), problem.model.state_len());
     Ok(Equilibrium {
         state: problem.y,
-        force,
+        parameters: vec![force],
+        tensions: rule.tensions(&[force]),
         iterations: report.iterations,
         residual: report.residual,
     })
 }
 
-/// The static problem and its straight-chord guess (unknowns, F0 = 0 last).
-fn problem(
-    model: &mut Fe,
-    effector_x: f64,
-    tension_sum: f64,
-) -> Result<(Problem<'_>, Vec<f64>), ModelError> {
+/// The static problem under `rule` (the effector's x pinned, one parameter: the paper's rule)
+/// and its straight-chord guess (unknowns, F0 = 0 last).
+fn problem<'a>(
+    model: &'a mut Fe,
+    rule: &'a dyn RestRule<2>,
+) -> Result<(Problem<'a>, Vec<f64>), ModelError> {
+    let effector_x = match rule.pinned() {
+        &[(0, x)] => x,
+        pinned => {
+            return Err(ModelError::Parameter {
+                name: "rest rule",
+                value: pinned.len() as f64,
+                allowed: "the effector's x pinned and one parameter: the planar FE statics".into(),
+            });
+        }
+    };
+    // The tensions at a zero parameter: the rule's pretension (the paper's ΣT, split evenly).
+    let tension_sum: f64 = rule.tensions(&[0.0]).iter().sum();
     cdpr_core::model::check_effector_x(effector_x, model.anchor_distance)?;
     let d = model.anchor_distance;
     let n = model.elements;
@@ -196,7 +208,7 @@ fn problem(
     let problem = Problem {
         model,
         effector_x,
-        tension_sum,
+        rule,
         y,
         map,
         stiffness: vec![0.0; dynamic.len()],
@@ -231,7 +243,8 @@ mod tests {
                 ..Params::default()
             };
             let mut model = Fe::new(&Scenario::paper(), params).unwrap();
-            let (mut problem, u) = problem(&mut model, 0.6, 200.0).unwrap();
+            let rule = cdpr_core::model::SplitRule::new(0.6, 200.0);
+            let (mut problem, u) = problem(&mut model, &rule).unwrap();
             let n = u.len();
             let pattern = problem.pattern().unwrap();
             let mut by_blocks = vec![0.0; pattern.len()];

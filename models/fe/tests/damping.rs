@@ -6,7 +6,7 @@
 mod common;
 
 use cdpr_core::channel::Channel;
-use cdpr_core::model::CableModel;
+use cdpr_core::model::{CableModel, SplitRule};
 use cdpr_core::scenario::Scenario;
 use cdpr_fe::{Fe, FeMass, FeStored, Params};
 use common::*;
@@ -26,7 +26,7 @@ fn damped_energy_balance_holds() {
             scenario.cable.axial_damping = 1.0;
             let mut m = Fe::new(&scenario, params(10, mass, FeStored::Elastic)).unwrap();
             assert_eq!(m.axial_damping, 1.0);
-            let eq = m.equilibrium(0.5, 200.0).unwrap();
+            let eq = m.equilibrium(&SplitRule::new(0.5, 200.0)).unwrap();
             let np = m.positions_len();
             let mut y = eq.state.clone();
             for cable in 0..2 {
@@ -69,14 +69,14 @@ fn damping_vanishes_at_rest_and_is_validated() {
     damped_scenario.cable.axial_damping = 3.0;
     let mut damped = Fe::new(&damped_scenario, Params::default()).unwrap();
     let mut plain = model(10, FeMass::Consistent, FeStored::Elastic);
-    let eq = plain.equilibrium(0.6, 200.0).unwrap();
-    let eq_damped = damped.equilibrium(0.6, 200.0).unwrap();
+    let eq = plain.equilibrium(&SplitRule::new(0.6, 200.0)).unwrap();
+    let eq_damped = damped.equilibrium(&SplitRule::new(0.6, 200.0)).unwrap();
     assert_eq!(eq.state, eq_damped.state);
     let n = plain.state_len();
     let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
-    let t = tensions(200.0, eq.force);
-    plain.rhs(0.0, &eq.state, t, &mut a);
-    damped.rhs(0.0, &eq.state, t, &mut b);
+    let t = tensions(200.0, eq.force());
+    plain.rhs(0.0, &eq.state, &t, &mut a);
+    damped.rhs(0.0, &eq.state, &t, &mut b);
     assert_eq!(a, b);
     assert_eq!(damped.dissipation(&eq.state), 0.0);
     for bad in [-1.0, f64::NAN] {

@@ -6,7 +6,7 @@
 mod common;
 
 use cdpr_core::Vector2;
-use cdpr_core::model::CableModel;
+use cdpr_core::model::{CableModel, SplitRule};
 use cdpr_core::scenario::Scenario;
 use cdpr_fe::element::{self, ElementState, MassCoefficients, Material};
 use cdpr_fe::{E_OUT, Fe, FeMass, FeStored};
@@ -342,8 +342,8 @@ fn steady_pay_out_is_a_steady_state() {
         let mut s = Scenario::paper();
         s.robot.gravity = 0.0;
         let mut m = Fe::new(&s, params(10, FeMass::Consistent, stored)).unwrap();
-        let eq = m.equilibrium(0.5, 200.0).unwrap();
-        assert!(eq.force.abs() < 1e-9);
+        let eq = m.equilibrium(&SplitRule::new(0.5, 200.0)).unwrap();
+        assert!(eq.force().abs() < 1e-9);
         let mut y = eq.state;
         let np = m.positions_len();
         let nn = m.chain_nodes();
@@ -409,7 +409,7 @@ proptest! {
         let other = random_state(&mut m, 1.0 - x, seed ^ 1, 1e-3, 1.0);
         m.force_vector(&other, [t2, t1]);
         let mut r = vec![f64::NAN; np];
-        m.second_order_mut().unwrap().residual(&y, &qdd, [t1, t2], &mut r);
+        m.second_order_mut().unwrap().residual(&y, &qdd, &[t1, t2], &mut r);
         let mm = m.mass_matrix(&y);
         let f = m.force_vector(&y, [t1, t2]);
         let m_qdd = &mm * nalgebra::DVector::from_column_slice(&qdd);

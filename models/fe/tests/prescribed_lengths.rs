@@ -8,7 +8,7 @@
 
 mod common;
 
-use cdpr_core::model::CableModel;
+use cdpr_core::model::{CableModel, SplitRule};
 use cdpr_fe::{Fe, FeMass, FeStored};
 use cdpr_numerics::{Dopri5, Dopri5Options, OdeSystem};
 use common::model;
@@ -128,7 +128,7 @@ impl OdeSystem for PrescribedLengths {
 fn energy_identity_with_prescribed_lengths() {
     for (rtol, atol, bound) in [(1e-5, 1e-8, 1e-7), (1e-8, 1e-11, 1e-8)] {
         let mut m: Fe = model(10, FeMass::Consistent, FeStored::Rigid);
-        let eq = m.equilibrium(0.5, 200.0).unwrap();
+        let eq = m.equilibrium(&SplitRule::new(0.5, 200.0)).unwrap();
         let np = m.positions_len();
         let l = [m.l_index(0), m.l_index(1)];
         let free: Vec<usize> = (0..np).filter(|i| !l.contains(i)).collect();

@@ -6,7 +6,7 @@ mod common;
 
 use cdpr_core::channel::Channel;
 use cdpr_core::closed_loop::ClosedLoop;
-use cdpr_core::model::CableModel;
+use cdpr_core::model::{CableModel, SplitRule};
 use cdpr_core::runner::{RunOptions, simulate_from};
 use cdpr_core::scenario::Scenario;
 use cdpr_core::trajectory::Step5;
@@ -24,8 +24,8 @@ fn paper_model() -> Fe {
 #[test]
 fn symmetric_start_is_symmetric() {
     let mut m = paper_model();
-    let eq = m.equilibrium(0.5, 200.0).unwrap();
-    assert!(eq.force.abs() < 1e-9, "F0 = {:e}", eq.force);
+    let eq = m.equilibrium(&SplitRule::new(0.5, 200.0)).unwrap();
+    assert!(eq.force().abs() < 1e-9, "F0 = {:e}", eq.force());
     let mut worst: f64 = 0.0;
     for k in 1..m.elements {
         let (a, _) = node(&m, &eq.state, 0, k);
@@ -34,7 +34,7 @@ fn symmetric_start_is_symmetric() {
     }
     let (l1, l2) = (m.free_length(&eq.state, 0), m.free_length(&eq.state, 1));
     worst = worst.max((l1 - l2).abs());
-    eprintln!("F0 = {:e} N, mirror defect {worst:e} m", eq.force);
+    eprintln!("F0 = {:e} N, mirror defect {worst:e} m", eq.force());
     assert!(worst < 1e-12, "mirror defect {worst:e} m");
 }
 
@@ -44,7 +44,7 @@ fn symmetric_start_is_symmetric() {
 fn equilibrium_is_preserved() {
     let mut scenario = Scenario::paper();
     scenario.trajectory.x2 = scenario.trajectory.x1;
-    let mut sys = ClosedLoop::new(paper_model(), &scenario);
+    let mut sys = ClosedLoop::new(paper_model(), &scenario).unwrap();
     sys.trajectory = Step5::from(&scenario.trajectory);
     let (y0, eq) = sys.initial_state().unwrap();
     let z0 = sys.model.effector(&y0).position.y;
@@ -87,7 +87,7 @@ fn cdpr_statics_match_the_continuum() {
     ];
     let mut m = paper_model();
     for (x, z, l1, l2, f0, n1, n2) in table {
-        let eq = m.equilibrium(x, 200.0).unwrap();
+        let eq = m.equilibrium(&SplitRule::new(x, 200.0)).unwrap();
         let y = &eq.state;
         let zp = m.effector(y).position.y;
         let (a, b) = (m.free_length(y, 0), m.free_length(y, 1));
@@ -96,14 +96,14 @@ fn cdpr_statics_match_the_continuum() {
             zp - z,
             a - l1,
             b - l2,
-            eq.force - f0
+            eq.force() - f0
         );
         assert!((zp - z).abs() < 1e-8, "z_P = {zp}");
         assert!(
             (a - l1).abs() < 1e-8 && (b - l2).abs() < 1e-8,
             "l = {a}, {b}"
         );
-        assert!((eq.force - f0).abs() < 1e-5, "F0 = {}", eq.force);
+        assert!((eq.force() - f0).abs() < 1e-5, "F0 = {}", eq.force());
         for (c, expect) in [n1, n2].into_iter().enumerate() {
             let got = [
                 m.element_tension(y, c, 1).1,
@@ -119,7 +119,7 @@ fn cdpr_statics_match_the_continuum() {
             // The stored element carries the commanded tension to the reel (a straight element
             // on the reel line, no weight along it): its strain is T/EA and its tension T, to
             // the Newton stop (1e-7 N).
-            let commanded = 0.5 * (200.0 + if c == 0 { -eq.force } else { eq.force });
+            let commanded = 0.5 * (200.0 + if c == 0 { -eq.force() } else { eq.force() });
             let (strain, tension) = m.stored_tension(y, c).expect("elastic stored cable");
             assert!(
                 (tension - commanded).abs() < 1e-6,
@@ -143,7 +143,7 @@ fn energy_identity_with_prescribed_tensions() {
     for (rtol, atol, bound) in [(1e-5, 1e-8, 1e-7), (1e-8, 1e-11, 1e-8)] {
         let scenario = Scenario::paper();
         let mut m = paper_model();
-        let eq = m.equilibrium(0.5, 200.0).unwrap();
+        let eq = m.equilibrium(&SplitRule::new(0.5, 200.0)).unwrap();
         let y = eq.state.clone();
         let (run, worst) = wobbling_run(m, &scenario, eq, y, 0.5, (rtol, atol));
         let throughput = column_max_abs(&run, Channel::WReel);
@@ -195,8 +195,8 @@ fn linearised_frequencies_match_models_md() {
         (0.5, 19.917, Some([536.24, 536.99]), 2.409e5),
         (0.6, 20.328, None, 3.008e5),
     ] {
-        let eq = m.equilibrium(x, 200.0).unwrap();
-        let w = open_loop_frequencies(&mut m, &eq.state, tensions(200.0, eq.force));
+        let eq = m.equilibrium(&SplitRule::new(x, 200.0)).unwrap();
+        let w = open_loop_frequencies(&mut m, &eq.state, tensions(200.0, eq.force()));
         eprintln!("x = {x}: {:?} … max {:.1}", &w[..5], w[w.len() - 1]);
         // The drift mode (0.974 rad/s), then the vertical mode.
         assert!((w[0] - 0.974).abs() < 0.005, "drift {}", w[0]);

@@ -150,7 +150,7 @@ impl Lumped {
         true
     }
 
-    fn residual_into(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]) {
+    fn residual_into(&mut self, state: &[f64], qdd: &[f64], tensions: &[f64], r: &mut [f64]) {
         let n = self.elements;
         let mut f = std::mem::take(&mut self.implicit.forces);
         f.resize(self.positions_len(), 0.0);
@@ -166,19 +166,30 @@ impl Lumped {
     }
 }
 
+impl Lumped {
+    /// Index of the effector's x among q.
+    pub fn effector_x(&self) -> usize {
+        self.xi(0, self.elements)
+    }
+
+    /// Index of the effector's z among q.
+    pub fn effector_z(&self) -> usize {
+        self.zi(0, self.elements)
+    }
+}
+
 impl SecondOrderForm for Lumped {
     fn dofs(&self) -> usize {
         self.positions_len()
     }
 
-    fn effector_x(&self) -> usize {
-        self.xi(0, self.elements)
+    fn effector_coordinate(&self, k: usize) -> usize {
+        if k == 0 {
+            self.effector_x()
+        } else {
+            self.effector_z()
+        }
     }
-
-    fn effector_z(&self) -> usize {
-        self.zi(0, self.elements)
-    }
-
     /// The commanded tension pulls the reel end P_0 along e_out (horizontal).
     fn tension_rows(&self) -> Vec<usize> {
         vec![self.xi(0, 0), self.xi(1, 0)]
@@ -212,7 +223,7 @@ impl SecondOrderForm for Lumped {
         pattern
     }
 
-    fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: [f64; 2], r: &mut [f64]) {
+    fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: &[f64], r: &mut [f64]) {
         self.residual_into(state, qdd, tensions, r);
     }
 
@@ -256,7 +267,7 @@ impl SecondOrderForm for Lumped {
         &mut self,
         state: &[f64],
         qdd: &[f64],
-        tensions: [f64; 2],
+        tensions: &[f64],
         c_v: f64,
         c_q: f64,
         values: &mut [f64],
@@ -274,7 +285,7 @@ impl Lumped {
         &mut self,
         state: &[f64],
         qdd: &[f64],
-        tensions: [f64; 2],
+        tensions: &[f64],
         c_v: f64,
         c_q: f64,
         values: &mut [f64],
@@ -309,7 +320,7 @@ impl Lumped {
 mod tests {
     use super::*;
     use crate::Params;
-    use cdpr_core::model::CableModel;
+    use cdpr_core::model::{CableModel, SplitRule};
     use cdpr_core::scenario::Scenario;
     use proptest::prelude::*;
 
@@ -333,7 +344,7 @@ mod tests {
         ) {
             let s = Scenario::paper();
             let mut model = Lumped::new(&s, Params::default()).unwrap();
-            let eq = model.equilibrium(x, s.controller.tension_sum).unwrap();
+            let eq = model.equilibrium(&SplitRule::new(x, s.controller.tension_sum)).unwrap();
             let mut state = eq.state.clone();
             let n = model.elements;
             for cable in 0..2 {
@@ -351,7 +362,7 @@ mod tests {
             let len = model.iteration_pattern().len();
             let (mut analytic, mut differenced) = (vec![0.0; len], vec![0.0; len]);
             prop_assert!(model.tangent_matrix(&state, c_q, &mut analytic));
-            model.differenced_matrix(&state, &qdd, [100.0, 100.0], 0.0, c_q, &mut differenced);
+            model.differenced_matrix(&state, &qdd, &[100.0, 100.0], 0.0, c_q, &mut differenced);
             let mut masses = vec![0.0; len];
             prop_assert!(model.tangent_matrix(&state, 0.0, &mut masses));
             let scale = differenced

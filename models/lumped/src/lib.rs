@@ -21,7 +21,8 @@ pub mod params;
 mod pulley;
 mod statics;
 
-use cdpr_core::model::{CableModel, Effector, Energy, Equilibrium, ModelError, ModelEvent};
+use cdpr_core::model::{CableModel, Energy, Equilibrium, ModelError, ModelEvent, RestRule};
+use cdpr_core::robot::{Effector, PerCable, Robot};
 use cdpr_core::scenario::Scenario;
 use nalgebra::Vector2;
 
@@ -31,7 +32,9 @@ pub use pulley::PULLEY_OFFSET;
 /// The two-cable robot with lumped mass-spring cables.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Lumped {
-    /// Pulley distance d [m]: A1 = (0, 0), A2 = (d, 0).
+    /// The planar robot: pulleys A1 = (0, 0), A2 = (d, 0).
+    pub robot: Robot<2>,
+    /// Pulley distance d [m].
     pub anchor_distance: f64,
     /// Effector mass M [kg].
     pub effector_mass: f64,
@@ -107,6 +110,7 @@ impl Lumped {
         let cable = &scenario.cable;
         let segment = cable.modelled_length / n as f64;
         Ok(Self {
+            robot: scenario.robot(),
             anchor_distance: scenario.robot.anchor_distance,
             effector_mass: scenario.robot.effector_mass,
             gravity: scenario.robot.gravity,
@@ -230,7 +234,7 @@ impl Lumped {
     /// pulley: eq. 7), for the commanded tensions. The springs between
     /// two cable nodes are computed in one vectorisable sweep; the straddling spring and the spring
     /// to the effector are then recomputed along the cable path.
-    fn forces(&mut self, y: &[f64], tensions: [f64; 2], out: &mut [f64]) {
+    fn forces(&mut self, y: &[f64], tensions: &[f64], out: &mut [f64]) {
         let n = self.elements;
         let np = self.positions_len();
         let (k, l0, c) = (self.stiffness, self.segment, self.damping);
@@ -322,24 +326,24 @@ impl Lumped {
     }
 }
 
-impl CableModel for Lumped {
+impl CableModel<2> for Lumped {
     fn name(&self) -> &'static str {
         "lumped"
+    }
+
+    fn robot(&self) -> &Robot<2> {
+        &self.robot
     }
 
     fn state_len(&self) -> usize {
         2 * self.positions_len()
     }
 
-    fn equilibrium(
-        &mut self,
-        effector_x: f64,
-        tension_sum: f64,
-    ) -> Result<Equilibrium, ModelError> {
-        statics::equilibrium(self, effector_x, tension_sum)
+    fn equilibrium(&mut self, rule: &dyn RestRule<2>) -> Result<Equilibrium, ModelError> {
+        statics::equilibrium(self, rule)
     }
 
-    fn rhs(&mut self, _t: f64, y: &[f64], tensions: [f64; 2], rate: &mut [f64]) {
+    fn rhs(&mut self, _t: f64, y: &[f64], tensions: &[f64], rate: &mut [f64]) {
         let n = self.elements;
         let np = self.positions_len();
         let (dq, dv) = rate.split_at_mut(np);
@@ -355,7 +359,7 @@ impl CableModel for Lumped {
         }
     }
 
-    fn effector(&self, y: &[f64]) -> Effector {
+    fn effector(&self, y: &[f64]) -> Effector<2> {
         Effector {
             position: self.node(y, 0, self.elements),
             velocity: self.node_velocity(y, 0, self.elements),
@@ -363,8 +367,8 @@ impl CableModel for Lumped {
     }
 
     /// The reel end P_0 moving along e_out takes cable in.
-    fn reel_speeds(&self, y: &[f64]) -> [f64; 2] {
-        [0, 1].map(|c| self.node_velocity(y, c, 0).x * E_OUT[c])
+    fn reel_speeds(&self, y: &[f64]) -> PerCable {
+        PerCable::from_fn(2, |c| self.node_velocity(y, c, 0).x * E_OUT[c])
     }
 
     fn energy(&self, y: &[f64]) -> Energy {
@@ -437,19 +441,21 @@ impl CableModel for Lumped {
     }
 
     fn channel_names(&self) -> Vec<String> {
-        cdpr_core::channel::Channel::CABLE
-            .map(|c| c.name().to_owned())
-            .to_vec()
+        cdpr_core::channel::Channel::cable_channels(2)
+            .into_iter()
+            .map(|c| c.name())
+            .collect()
     }
 
     fn channel_units(&self) -> Vec<&'static str> {
         use cdpr_core::channel::Channel;
-        Channel::CABLE
+        Channel::cable_channels(2)
+            .into_iter()
             .map(|c| match c {
                 Channel::Stored(_) => "nodes",
                 c => c.unit(),
             })
-            .to_vec()
+            .collect()
     }
 
     fn second_order(&self) -> Option<&dyn cdpr_core::second_order::SecondOrderForm> {
@@ -466,7 +472,7 @@ impl CableModel for Lumped {
 
     /// Spring tensions at the effector and over the pulley [N], free unstrained lengths [m] and
     /// stored-node counts.
-    fn channels(&self, y: &[f64], _tensions: [f64; 2], out: &mut [f64]) {
+    fn channels(&self, y: &[f64], _tensions: &[f64], out: &mut [f64]) {
         let n = self.elements;
         let straddle = |c: usize| {
             let r = self.stored[c];

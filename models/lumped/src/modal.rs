@@ -11,8 +11,7 @@ impl Lumped {
         let n = self.elements;
         let mut layout = ModalLayout {
             dofs: vec![Dof::Effector {
-                x: self.xi(0, n),
-                z: self.zi(0, n),
+                coordinates: vec![self.xi(0, n), self.zi(0, n)],
                 mass: self.effector_mass,
             }],
             frozen: Vec::new(),
@@ -35,11 +34,11 @@ impl Lumped {
                         self.node(y, cable, j - 1)
                     };
                     let next = self.node(y, cable, j + 1);
+                    let tangent = (next - prev).normalize();
                     layout.dofs.push(Dof::Node {
                         cable,
-                        x,
-                        z,
-                        tangent: (next - prev).normalize(),
+                        coordinates: vec![x, z],
+                        tangent: vec![tangent.x, tangent.y],
                         mass: self.node_mass,
                     });
                 }

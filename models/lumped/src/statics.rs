@@ -15,18 +15,18 @@
 
 use crate::pulley::beyond;
 use crate::{E_OUT, Lumped};
-use cdpr_core::controller::split_tensions;
-use cdpr_core::model::{CableModel, Equilibrium, ModelError};
+use cdpr_core::model::{CableModel, Equilibrium, ModelError, RestRule};
+use cdpr_core::robot::Tensions;
 use cdpr_core::second_order::SecondOrderForm;
 use cdpr_core::statics;
 use cdpr_numerics::newton::{self, NewtonOptions, StaticProblem};
 use nalgebra::Vector2;
 
 /// The unknowns ↔ state map and the force residual for a fixed split r.
-struct Problem {
+struct Problem<'a> {
     model: Lumped,
     effector_x: f64,
-    tension_sum: f64,
+    rule: &'a dyn RestRule<2>,
     /// State vector being assembled (velocities stay zero).
     y: Vec<f64>,
     forces: Vec<f64>,
@@ -42,8 +42,8 @@ struct Problem {
     masses: Vec<f64>,
 }
 
-impl Problem {
-    fn new(model: Lumped, effector_x: f64, tension_sum: f64) -> Self {
+impl<'a> Problem<'a> {
+    fn new(model: Lumped, effector_x: f64, rule: &'a dyn RestRule<2>) -> Self {
         let mut map = Vec::new();
         for cable in 0..2 {
             for j in 0..model.elements {
@@ -70,7 +70,7 @@ impl Problem {
             unknown,
             model,
             effector_x,
-            tension_sum,
+            rule,
             map,
         };
         problem.pattern = statics::pattern_from_dynamics(
@@ -92,8 +92,8 @@ impl Problem {
         }
     }
 
-    fn tensions(&self, force: f64) -> [f64; 2] {
-        split_tensions(self.tension_sum, force)
+    fn tensions(&self, force: f64) -> Tensions {
+        self.rule.tensions(&[force])
     }
 
     fn load(&mut self, u: &[f64]) {
@@ -104,7 +104,7 @@ impl Problem {
     }
 }
 
-impl StaticProblem for Problem {
+impl StaticProblem for Problem<'_> {
     fn dimension(&self) -> usize {
         self.map.len() + 1
     }
@@ -114,7 +114,7 @@ impl StaticProblem for Problem {
     fn residual(&mut self, u: &[f64], r: &mut [f64]) {
         self.load(u);
         let tensions = self.tensions(u[self.map.len()]);
-        self.model.forces(&self.y, tensions, &mut self.forces);
+        self.model.forces(&self.y, &tensions, &mut self.forces);
         for (k, &i) in self.map.iter().enumerate() {
             r[k] = self.forces[i];
         }
@@ -147,9 +147,10 @@ impl StaticProblem for Problem {
             *value = self.masses[p] - self.tangent[p];
         }
         let mut at = kept.len();
+        let slope = self.rule.slope(0);
         for (cable, row) in self.model.tension_rows().into_iter().enumerate() {
             if self.row_of(row).is_some() {
-                values[at] = [-0.5, 0.5][cable] * E_OUT[cable];
+                values[at] = slope[cable] * E_OUT[cable];
                 at += 1;
             }
         }
@@ -199,7 +200,7 @@ impl StaticProblem for Problem {
     /// which the residual depends linearly.
     fn scale(&self, i: usize) -> f64 {
         if i == self.map.len() {
-            self.tension_sum
+            self.rule.scale(0)
         } else {
             1e-4
         }
@@ -326,12 +327,25 @@ fn split_by_side_rule(model: &Lumped, y: &[f64]) -> Option<[usize; 2]> {
     })
 }
 
-/// Equilibrium with the split found by the side rule (MODELS.md §2, §4).
+/// Equilibrium under `rule` (the effector's x pinned, one parameter: the paper's rule) with the
+/// split found by the side rule (MODELS.md §2, §4).
 pub(crate) fn equilibrium(
     model: &mut Lumped,
-    effector_x: f64,
-    tension_sum: f64,
+    rule: &dyn RestRule<2>,
 ) -> Result<Equilibrium, ModelError> {
+    let effector_x = match rule.pinned() {
+        &[(0, x)] => x,
+        pinned => {
+            return Err(ModelError::Parameter {
+                name: "rest rule",
+                value: pinned.len() as f64,
+                allowed: "the effector's x pinned and one parameter: the planar lumped statics"
+                    .into(),
+            });
+        }
+    };
+    // The tensions at a zero parameter: the rule's pretension (the paper's ΣT, split evenly).
+    let tension_sum: f64 = rule.tensions(&[0.0]).iter().sum();
     cdpr_core::model::check_effector_x(effector_x, model.anchor_distance)?;
     let d = model.anchor_distance;
     // Massless-cable sag as the effector's starting depth; the cable weight adds ~1 %.
@@ -340,7 +354,7 @@ pub(crate) fn equilibrium(
     let ea = model.stiffness * model.segment;
     let mut y = guess(model, Vector2::new(effector_x, sag), 0.5 * tension_sum, ea);
     for _attempt in 0..MAX_SPLITS {
-        let mut problem = Problem::new(model.clone(), effector_x, tension_sum);
+        let mut problem = Problem::new(model.clone(), effector_x, rule);
         let mut u: Vec<f64> = problem.map.iter().map(|&i| y[i]).collect();
         u.push(0.0);
         let solved = newton::solve(&mut problem, &mut u, NewtonOptions::default());
@@ -363,9 +377,11 @@ pub(crate) fn equilibrium(
         match split_by_side_rule(model, &y) {
             Some(shifted) => reclassify(model, &mut y, shifted, effector_x),
             None => {
+                let force = u[problem.map.len()];
                 return Ok(Equilibrium {
                     state: y,
-                    force: u[problem.map.len()],
+                    parameters: vec![force],
+                    tensions: rule.tensions(&[force]),
                     iterations: report.iterations,
                     residual: report.residual,
                 });
@@ -384,6 +400,7 @@ pub(crate) fn equilibrium(
 mod tests {
     use super::*;
     use crate::Params;
+    use cdpr_core::model::SplitRule;
     use cdpr_core::scenario::Scenario;
 
     /// The exact static Jacobian against central differences of the residual, entry by entry
@@ -397,11 +414,12 @@ mod tests {
     fn static_jacobian_matches_central_differences() {
         let s = Scenario::paper();
         let mut model = Lumped::new(&s, Params::default()).unwrap();
-        let eq = model.equilibrium(0.6, 200.0).unwrap();
-        let mut problem = Problem::new(model, 0.6, 200.0);
+        let rule = SplitRule::new(0.6, 200.0);
+        let eq = model.equilibrium(&rule).unwrap();
+        let mut problem = Problem::new(model, 0.6, &rule);
         let n = problem.dimension();
         let mut u: Vec<f64> = problem.map.iter().map(|&i| eq.state[i]).collect();
-        u.push(eq.force);
+        u.push(eq.force());
         for (k, v) in u.iter_mut().enumerate().take(n - 1) {
             *v += 3e-6 * (1.3 * k as f64).sin();
         }

@@ -5,7 +5,8 @@
 
 use cdpr_core::channel::Channel;
 use cdpr_core::closed_loop::{Actuation, ClosedLoop};
-use cdpr_core::model::CableModel;
+use cdpr_core::model::{CableModel, SplitRule};
+use cdpr_core::robot::Tensions;
 use cdpr_core::runner::{RunOptions, simulate_from};
 use cdpr_core::scenario::Scenario;
 use cdpr_lumped::{Lumped, Params};
@@ -22,7 +23,7 @@ fn damped_energy_balance_holds() {
     let mut s = Scenario::paper();
     s.cable.axial_damping = 1.0;
     let mut m = Lumped::new(&s, Params::default()).unwrap();
-    let eq = m.equilibrium(0.5, 200.0).unwrap();
+    let eq = m.equilibrium(&SplitRule::new(0.5, 200.0)).unwrap();
     let np = m.positions_len();
     let mut y = eq.state.clone();
     y[np + m.xi(0, 0)] = -0.5;
@@ -30,13 +31,13 @@ fn damped_energy_balance_holds() {
     y[np + m.zi(0, m.elements)] = 0.05;
     assert!(m.dissipation(&y) >= 0.0);
     y.extend_from_slice(&[0.0; 4]);
-    let mut sys = ClosedLoop::new(m, &s);
+    let mut sys = ClosedLoop::new(m, &s).unwrap();
     let pi = std::f64::consts::PI;
     sys.actuation = Actuation::Prescribed(Box::new(move |t| {
-        [
+        Tensions::pair([
             100.0 + 10.0 * (6.0 * pi * t).sin(),
             100.0 + 10.0 * (6.0 * pi * t + 0.5).sin() + 3.0 * (14.0 * pi * t).sin(),
-        ]
+        ])
     }));
     let opts = RunOptions::dopri5(
         0.2,

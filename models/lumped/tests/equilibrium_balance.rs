@@ -4,7 +4,7 @@
 //! 1 % more, whose springs are 1 % stiffer or whose pulley path is wrong balances its own forces
 //! but not these.
 
-use cdpr_core::model::CableModel;
+use cdpr_core::model::{CableModel, SplitRule};
 use cdpr_core::scenario::Scenario;
 use cdpr_lumped::{E_OUT, Lumped, Params};
 use nalgebra::Vector2;
@@ -46,10 +46,10 @@ fn solve(c: Case) -> (Lumped, Vec<f64>, [f64; 2], Totals) {
         },
     )
     .unwrap();
-    let eq = m.equilibrium(c.x, c.tension_sum).unwrap();
+    let eq = m.equilibrium(&SplitRule::new(c.x, c.tension_sum)).unwrap();
     let commanded = [
-        0.5 * (c.tension_sum - eq.force),
-        0.5 * (c.tension_sum + eq.force),
+        0.5 * (c.tension_sum - eq.force()),
+        0.5 * (c.tension_sum + eq.force()),
     ];
     let n = c.elements as f64;
     let area = s.cable.area;

@@ -2,9 +2,10 @@
 //! the paper's damped-relaxation method, the energy balance with the PID off, and the invariants
 //! of the pulley rule through events.
 
-use cdpr_core::channel::{Cable, Channel};
+use cdpr_core::channel::Channel;
 use cdpr_core::closed_loop::{Actuation, ClosedLoop};
-use cdpr_core::model::{CableModel, Equilibrium};
+use cdpr_core::model::{CableModel, Equilibrium, SplitRule};
+use cdpr_core::robot::{CableId, Tensions};
 use cdpr_core::runner::{RunOptions, simulate, simulate_from};
 use cdpr_core::scenario::Scenario;
 use cdpr_lumped::{E_OUT, Lumped, Params};
@@ -15,8 +16,8 @@ fn paper() -> Scenario {
     Scenario::paper()
 }
 
-fn tensions(tension_sum: f64, force: f64) -> [f64; 2] {
-    [0.5 * (tension_sum - force), 0.5 * (tension_sum + force)]
+fn tensions(tension_sum: f64, force: f64) -> Tensions {
+    Tensions::pair([0.5 * (tension_sum - force), 0.5 * (tension_sum + force)])
 }
 
 /// (P_j − A_i)·e_out,i: > 0 beyond the pulley (stored side).
@@ -38,11 +39,15 @@ fn side_rule_holds(m: &Lumped, y: &[f64]) -> bool {
 #[test]
 fn equilibrium_matches_the_independent_solution() {
     let mut m = Lumped::new(&paper(), Params::default()).unwrap();
-    let eq = m.equilibrium(0.5, 200.0).unwrap();
+    let eq = m.equilibrium(&SplitRule::new(0.5, 200.0)).unwrap();
     assert_eq!(m.stored(), [20, 20]);
     let z = m.effector(&eq.state).position.y;
     assert!((z + 0.0247166).abs() < 5e-8, "z_P = {z}");
-    assert!(eq.force.abs() < 1e-9, "symmetric start: F0 = {}", eq.force);
+    assert!(
+        eq.force().abs() < 1e-9,
+        "symmetric start: F0 = {}",
+        eq.force()
+    );
     let straddle = m.spring_force(&eq.state, 0, 19);
     assert!(
         (straddle - 100.000).abs() < 5e-4,
@@ -55,18 +60,23 @@ fn equilibrium_matches_the_independent_solution() {
     );
     assert!(eq.residual < 1e-7);
 
-    let eq = m.equilibrium(0.6, 200.0).unwrap();
+    let eq = m.equilibrium(&SplitRule::new(0.6, 200.0)).unwrap();
     assert_eq!(m.stored(), [16, 24]);
     let z = m.effector(&eq.state).position.y;
     assert!((z + 0.0237291).abs() < 5e-8, "z_P = {z}");
-    assert!((eq.force - 0.097531).abs() < 5e-7, "F0 = {}", eq.force);
+    assert!((eq.force() - 0.097531).abs() < 5e-7, "F0 = {}", eq.force());
 }
 
 /// The largest force on any coordinate at `eq` under its commanded tensions [N] (the masses
 /// folded back into the accelerations).
 fn largest_force(m: &mut Lumped, eq: &Equilibrium, tension_sum: f64) -> f64 {
     let mut rate = vec![0.0; m.state_len()];
-    m.rhs(0.0, &eq.state, tensions(tension_sum, eq.force), &mut rate);
+    m.rhs(
+        0.0,
+        &eq.state,
+        &tensions(tension_sum, eq.force()),
+        &mut rate,
+    );
     let np = m.positions_len();
     (0..np)
         .map(|i| {
@@ -106,7 +116,7 @@ fn equilibrium_beside_a_pulley_obeys_the_side_rule() {
     ] {
         let mut m = Lumped::new(&paper(), Params::default()).unwrap();
         let eq = m
-            .equilibrium(x, tension_sum)
+            .equilibrium(&SplitRule::new(x, tension_sum))
             .unwrap_or_else(|e| panic!("x = {x} m, ΣT = {tension_sum} N: {e}"));
         assert!(side_rule_holds(&m, &eq.state), "stored {:?}", m.stored());
         let worst = largest_force(&mut m, &eq, tension_sum);
@@ -123,7 +133,7 @@ proptest! {
     #[test]
     fn equilibrium_anywhere_obeys_the_side_rule(x in 0.15f64..0.85, tension_sum in 120.0f64..400.0) {
         let mut m = Lumped::new(&paper(), Params::default()).unwrap();
-        let eq = m.equilibrium(x, tension_sum).unwrap();
+        let eq = m.equilibrium(&SplitRule::new(x, tension_sum)).unwrap();
         prop_assert!(side_rule_holds(&m, &eq.state), "stored {:?}", m.stored());
         let worst = largest_force(&mut m, &eq, tension_sum);
         prop_assert!(worst < 1e-7, "largest force {worst:e} N");
@@ -136,7 +146,7 @@ proptest! {
 /// relaxation must agree to 1e-9 m (MODELS.md §4, the required bound).
 struct Relaxation {
     model: Lumped,
-    tensions: [f64; 2],
+    tensions: Tensions,
     damping: f64,
 }
 
@@ -145,7 +155,7 @@ impl OdeSystem for Relaxation {
         self.model.state_len()
     }
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
-        self.model.rhs(t, y, self.tensions, dy);
+        self.model.rhs(t, y, &self.tensions, dy);
         let np = self.model.positions_len();
         for i in 0..np {
             dy[np + i] -= self.damping * y[np + i];
@@ -160,7 +170,7 @@ impl OdeSystem for Relaxation {
 fn damped_relaxation_reaches_the_newton_equilibrium() {
     for x in [0.5, 0.6] {
         let mut m = Lumped::new(&paper(), Params::default()).unwrap();
-        let eq = m.equilibrium(x, 200.0).unwrap();
+        let eq = m.equilibrium(&SplitRule::new(x, 200.0)).unwrap();
         let mut y = eq.state.clone();
         // Disturb every free coordinate (not the effector's x) by up to 1e-5 m, deterministically.
         let np = m.positions_len();
@@ -173,7 +183,7 @@ fn damped_relaxation_reaches_the_newton_equilibrium() {
         }
         y[m.zi(0, m.elements)] += 1e-5;
         let mut sys = Relaxation {
-            tensions: tensions(200.0, eq.force),
+            tensions: tensions(200.0, eq.force()),
             model: m.clone(),
             damping: 40.0,
         };
@@ -220,9 +230,9 @@ proptest! {
     ) {
         let scenario = paper();
         let mut m = Lumped::new(&scenario, Params::default()).unwrap();
-        let eq = m.equilibrium(0.5, 200.0).unwrap();
+        let eq = m.equilibrium(&SplitRule::new(0.5, 200.0)).unwrap();
         let d = if sign { delta } else { -delta };
-        let t = tensions(200.0, eq.force + 2.0 * d);
+        let t = tensions(200.0, eq.force() + 2.0 * d);
         let mut y = eq.state.clone();
         let np = m.positions_len();
         for c in 0..2 {
@@ -231,7 +241,7 @@ proptest! {
             }
         }
         y.extend_from_slice(&[0.0; 4]);
-        let mut sys = ClosedLoop::new(m, &scenario);
+        let mut sys = ClosedLoop::new(m, &scenario).unwrap();
         sys.actuation = Actuation::Prescribed(Box::new(move |_| t));
         let opts = RunOptions::dopri5(0.4, 1e-3, Dopri5Options { rtol: 1e-9, atol: 1e-12, ..Dopri5Options::default() });
         let run = simulate_from(&mut sys, y, eq, &opts, &mut |_| {}).unwrap();
@@ -258,12 +268,13 @@ fn events_keep_mass_nodes_and_ordering() {
     let mut sys = ClosedLoop::new(
         Lumped::new(&scenario, Params::default()).unwrap(),
         &scenario,
-    );
+    )
+    .unwrap();
     let mass = sys.model.cable_mass();
     let len = sys.model.state_len();
     let start = {
         let mut probe = Lumped::new(&scenario, Params::default()).unwrap();
-        probe.equilibrium(0.5, 200.0).unwrap();
+        probe.equilibrium(&SplitRule::new(0.5, 200.0)).unwrap();
         probe.stored()
     };
     let run = simulate(&mut sys, &RunOptions::from(&scenario), &mut |_| {}).unwrap();
@@ -292,8 +303,8 @@ fn events_keep_mass_nodes_and_ordering() {
     assert!(side_rule_holds(&sys.model, &run.final_state));
     let rows = run.series.len();
     let last = run.series.row(rows - 1);
-    for cable in Cable::BOTH {
-        let column = run.series.index(Channel::Stored(cable)).unwrap();
-        assert_eq!(last[column], stored[cable.index()] as f64);
+    for (cable, &count) in stored.iter().enumerate() {
+        let column = run.series.index(Channel::Stored(CableId(cable))).unwrap();
+        assert_eq!(last[column], count as f64);
     }
 }

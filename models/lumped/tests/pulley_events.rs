@@ -4,7 +4,7 @@
 //! kinetic energy, nothing when a node leaves the reel), and the cable's inertia is μ L0 per
 //! cable before and after events.
 
-use cdpr_core::model::CableModel;
+use cdpr_core::model::{CableModel, SplitRule};
 use cdpr_core::scenario::Scenario;
 use cdpr_lumped::{E_OUT, Lumped, Params};
 use proptest::prelude::*;
@@ -75,7 +75,7 @@ fn spring_tension(
 
 /// A static equilibrium at `x` with random velocities on every free node (`seed` picks them).
 fn moving_state(m: &mut Lumped, x: f64, tension_sum: f64, speed: f64, seed: u64) -> Vec<f64> {
-    let eq = m.equilibrium(x, tension_sum).unwrap();
+    let eq = m.equilibrium(&SplitRule::new(x, tension_sum)).unwrap();
     let mut y = eq.state;
     let np = m.positions_len();
     for cable in 0..2 {
@@ -159,7 +159,7 @@ proptest! {
         s.cable.modelled_length = 1.7;
         s.robot.effector_mass = effector_mass;
         let mut m = Lumped::new(&s, Params { elements }).unwrap();
-        let mut y = m.equilibrium(x, 200.0).unwrap().state;
+        let mut y = m.equilibrium(&SplitRule::new(x, 200.0)).unwrap().state;
         let np = m.positions_len();
         let expected = 0.5 * (effector_mass + 2.0 * density * area * 1.7) * v * v;
         let translate = |m: &Lumped, y: &mut [f64]| {

@@ -6,15 +6,16 @@
 
 use super::{ClosedLoop, Command, MAX_CONTROLLER_STATES};
 use crate::controller::{self, Controller, Reference};
-use crate::model::{CableModel, Effector};
+use crate::model::CableModel;
+use crate::robot::{Effector, MAX_AXES, Tensions};
 use cdpr_numerics::{MatrixCost, SecondOrderSystem};
 
 /// What an implicit step needs from its start (t_n, y_n) besides the integrator's own state.
 #[derive(Debug, Clone, Default)]
-pub(super) struct StepStart {
+pub(super) struct StepStart<const D: usize> {
     h: f64,
-    reference: Reference,
-    effector: Effector,
+    reference: Reference<D>,
+    effector: Effector<D>,
     states: [f64; MAX_CONTROLLER_STATES],
     saturated: bool,
     /// Reel power Σ T_i v_reel,i [W] and model dissipation [W] at t_n.
@@ -25,13 +26,13 @@ pub(super) struct StepStart {
     dissipated: f64,
 }
 
-impl<M: CableModel> ClosedLoop<M> {
+impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
     /// The command at the end t of the current implicit step for the effector state `effector`,
     /// and the controller states advanced there from the step's start (into `states`).
     fn step_end_command(
         &self,
         t: f64,
-        effector: &Effector,
+        effector: &Effector<D>,
         states: &mut [f64; MAX_CONTROLLER_STATES],
     ) -> Command {
         let s = &self.step_start;
@@ -49,38 +50,47 @@ impl<M: CableModel> ClosedLoop<M> {
     }
 
     /// The effector columns of the iteration matrix that close the loop through the tension
-    /// rows: x, then z where the controller measures it (the first `count` of the array).
-    fn effector_columns(&self) -> ([usize; 2], usize) {
+    /// rows: x, then the other axes where the controller measures them (the first `count` of
+    /// the array).
+    fn effector_columns(&self) -> ([usize; MAX_AXES], usize) {
+        let mut columns = [0; MAX_AXES];
         let Some(form) = self.model.second_order() else {
-            return ([0; 2], 0);
+            return (columns, 0);
         };
-        let count = if self.controller.measures().z { 2 } else { 1 };
-        ([form.effector_x(), form.effector_z()], count)
+        let count = if self.controller.measures().all_axes {
+            D
+        } else {
+            1
+        };
+        for (k, column) in columns.iter_mut().enumerate().take(count) {
+            *column = form.effector_coordinate(k);
+        }
+        (columns, count)
     }
 
     /// dT/dq_k + (c_v/c_q) dT/dq'_k of the step-end tensions for the effector coordinate k
-    /// (0: x, 1: z), by one-sided differences of the controller's advised step (exact for an
+    /// (0: x, …), by one-sided differences of the controller's advised step (exact for an
     /// affine controller with a unit step).
     fn tension_slope(
         &self,
         t: f64,
-        effector: &Effector,
-        tensions: [f64; 2],
+        effector: &Effector<D>,
+        tensions: &Tensions,
         k: usize,
         c_v: f64,
         c_q: f64,
-    ) -> [f64; 2] {
+    ) -> Tensions {
         let delta = self.controller.difference_step();
         let mut buffer = [0.0; MAX_CONTROLLER_STATES];
         let mut moved = *effector;
         moved.position[k] += delta;
         let at = self.step_end_command(t, &moved, &mut buffer).tensions;
-        let mut slope = [(at[0] - tensions[0]) / delta, (at[1] - tensions[1]) / delta];
+        let mut slope = Tensions::from_fn(tensions.len(), |i| (at[i] - tensions[i]) / delta);
         if self.controller.measures().velocity {
             let mut moving = *effector;
             moving.velocity[k] += delta;
             let at = self.step_end_command(t, &moving, &mut buffer).tensions;
-            for i in 0..2 {
+            for i in 0..tensions.len() {
                 slope[i] += c_v / c_q * (at[i] - tensions[i]) / delta;
             }
         }
@@ -88,7 +98,7 @@ impl<M: CableModel> ClosedLoop<M> {
     }
 }
 
-impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
+impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
     fn dofs(&self) -> usize {
         self.model.second_order().map_or(0, |f| f.dofs())
     }
@@ -136,7 +146,7 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         s.effector = effector;
         s.states[..c].copy_from_slice(&y[n..n + c]);
         s.saturated = cmd.saturated;
-        s.power = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
+        s.power = cmd.tensions.dot(&reel);
         s.dissipation = dissipation;
         s.work = y[n + c];
         s.dissipated = y[n + c + 1];
@@ -148,7 +158,7 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         let mut states = [0.0; MAX_CONTROLLER_STATES];
         let tensions = self.step_end_command(t, &effector, &mut states).tensions;
         if let Some(form) = self.model.second_order_mut() {
-            form.residual(&y[..n], qdd, tensions, r);
+            form.residual(&y[..n], qdd, &tensions, r);
         }
     }
 
@@ -166,9 +176,9 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         let mut states = [0.0; MAX_CONTROLLER_STATES];
         let tensions = self.step_end_command(t, &effector, &mut states).tensions;
         let columns = self.effector_columns().1;
-        let mut slopes = [[0.0; 2]; 2];
+        let mut slopes = [Tensions::zeros(tensions.len()); MAX_AXES];
         for (k, slope) in slopes.iter_mut().enumerate().take(columns) {
-            *slope = self.tension_slope(t, &effector, tensions, k, c_v, c_q);
+            *slope = self.tension_slope(t, &effector, &tensions, k, c_v, c_q);
         }
         let [base, probe] = &mut self.residual_scratch;
         let Some(form) = self.model.second_order_mut() else {
@@ -178,7 +188,7 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         let rows = form.tension_rows();
         let (model_values, tension_values) =
             values.split_at_mut(values.len() - rows.len() * columns);
-        let mut cost = form.iteration_matrix(&y[..n], qdd, tensions, c_v, c_q, model_values);
+        let mut cost = form.iteration_matrix(&y[..n], qdd, &tensions, c_v, c_q, model_values);
         base.resize(form.dofs(), 0.0);
         probe.resize(form.dofs(), 0.0);
         let mut base_done = false;
@@ -186,18 +196,18 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
             .iter()
             .zip(tension_values.chunks_mut(rows.len().max(1)))
         {
-            if *slope == [0.0, 0.0] || rows.is_empty() {
+            if slope.iter().all(|&s| s == 0.0) || rows.is_empty() {
                 column_values.fill(0.0);
                 continue;
             }
             // The column of ∂R/∂T · dT/dq, by residuals (R is linear in T).
             if !base_done {
-                form.residual(&y[..n], qdd, tensions, base);
+                form.residual(&y[..n], qdd, &tensions, base);
                 cost = cost.plus_residuals(1);
                 base_done = true;
             }
-            let pulled = [tensions[0] + slope[0], tensions[1] + slope[1]];
-            form.residual(&y[..n], qdd, pulled, probe);
+            let pulled = Tensions::from_fn(tensions.len(), |i| tensions[i] + slope[i]);
+            form.residual(&y[..n], qdd, &pulled, probe);
             cost = cost.plus_residuals(1);
             for (value, &row) in column_values.iter_mut().zip(&rows) {
                 *value = c_q * (probe[row] - base[row]);
@@ -229,7 +239,7 @@ impl<M: CableModel> SecondOrderSystem for ClosedLoop<M> {
         let cmd = self.step_end_command(t, &effector, &mut states);
         y[n..n + c].copy_from_slice(&states[..c]);
         let reel = self.model.reel_speeds(&y[..n]);
-        let power = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
+        let power = cmd.tensions.dot(&reel);
         let dissipation = self.model.dissipation(&y[..n]);
         let s = &self.step_start;
         y[n + c] = s.work + 0.5 * s.h * (s.power + power);

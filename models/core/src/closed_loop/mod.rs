@@ -11,9 +11,11 @@
 mod implicit;
 mod rest;
 
-use crate::Vector2;
+pub use rest::LoopError;
+
 use crate::controller::{self, AnyController, Controller, Reference, TensionLimits};
-use crate::model::{CableModel, Effector};
+use crate::model::CableModel;
+use crate::robot::{Effector, Robot, Tensions, Vector};
 use crate::scenario::Scenario;
 use crate::shaper::Impulses;
 use crate::trajectory::Step5;
@@ -23,9 +25,9 @@ use cdpr_numerics::OdeSystem;
 pub enum Actuation {
     /// The scenario's controller, clamped to the tension limits.
     Controller,
-    /// Tensions prescribed as functions of time [s] → [T1, T2] [N]; the controller states still
-    /// integrate the error but do not act (energy and verification runs).
-    Prescribed(Box<dyn Fn(f64) -> [f64; 2] + Send + Sync>),
+    /// Tensions prescribed as functions of time [s] → T_1 … T_m [N]; the controller states
+    /// still integrate the error but do not act (energy and verification runs).
+    Prescribed(Box<dyn Fn(f64) -> Tensions + Send + Sync>),
 }
 
 /// What the controller commands at one instant.
@@ -35,10 +37,11 @@ pub struct Command {
     pub reference: f64,
     /// e = x_ref − x [m].
     pub error: f64,
-    /// The controller's horizontal force F [N] (pulls toward A2 when positive).
+    /// The controller's horizontal force F [N] (the x component of its wrench; pulls toward A2
+    /// when positive).
     pub force: f64,
-    /// Commanded tensions [T1, T2] [N], inside the limits.
-    pub tensions: [f64; 2],
+    /// Commanded tensions T_1 … T_m [N], inside the limits.
+    pub tensions: Tensions,
     /// Whether the limits clamped the controller's tensions.
     pub saturated: bool,
 }
@@ -46,43 +49,50 @@ pub struct Command {
 /// Number of audit states (W, D) after the controller's.
 pub const AUDIT_STATES: usize = 2;
 
-/// Most controller states any controller has (stack buffers of the implicit step).
-pub const MAX_CONTROLLER_STATES: usize = 8;
+/// Most controller states a loop holds (stack buffers of the implicit step): the integral and
+/// filter states of the controllers acting on every axis of a spatial robot take 9.
+pub const MAX_CONTROLLER_STATES: usize = 12;
 
 /// Model + controller as one [`OdeSystem`].
-pub struct ClosedLoop<M: CableModel> {
+pub struct ClosedLoop<M: CableModel<D>, const D: usize> {
     pub model: M,
     pub trajectory: Step5,
     /// The input shaper the move is convolved with (one unit impulse: unshaped); None while
     /// the scenario's shaper design is still "auto" (the runner refuses to run then).
     pub shaper: Option<Impulses>,
-    pub controller: AnyController,
+    pub controller: AnyController<D>,
     pub limits: TensionLimits,
     pub actuation: Actuation,
     /// ΣT of the start equilibrium (MODELS.md §2) [N].
     pub tension_sum: f64,
-    /// Pulley distance d [m]: the runner stops a run whose effector leaves 0 < x < d, z < 0.
-    pub anchor_distance: f64,
-    /// The held height z0 [m] once the start equilibrium is known (the reference's z).
-    z_hold: Option<f64>,
+    /// The held start position once the start equilibrium is known (the reference's
+    /// coordinates but x).
+    hold: Option<Vector<D>>,
     /// Whether the controller reads the reference's velocity and acceleration.
     feedforward: bool,
     /// The tensions of the last rest state ([`ClosedLoop::rest_state`]) [N].
-    rest_tensions: [f64; 2],
+    rest_tensions: Tensions,
     /// The start of the current implicit step.
-    step_start: implicit::StepStart,
+    step_start: implicit::StepStart<D>,
     /// Two residuals for the tension columns of the implicit iteration matrix (allocated once).
     residual_scratch: [Vec<f64>; 2],
 }
 
-impl<M: CableModel> ClosedLoop<M> {
-    /// The loop for `model` with the scenario's controller, limits and trajectory.
-    pub fn new(model: M, scenario: &Scenario) -> Self {
-        let controller = controller::build(scenario);
+impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
+    /// The loop for `model` with the scenario's controller, limits and trajectory; refused when
+    /// the controller has more states than the loop's buffers hold.
+    pub fn new(model: M, scenario: &Scenario) -> Result<Self, LoopError> {
+        let controller = controller::build(scenario, *model.robot());
         let c = controller.state_len();
+        if c > MAX_CONTROLLER_STATES {
+            return Err(LoopError::ControllerStates {
+                controller: scenario.controller.kind.name(),
+                states: c,
+            });
+        }
         let feedforward = controller.uses_reference_derivatives();
-        debug_assert!(c <= MAX_CONTROLLER_STATES, "controller with {c} states");
-        Self {
+        let m = model.cables();
+        Ok(Self {
             model,
             trajectory: Step5::from(&scenario.trajectory),
             shaper: scenario.trajectory.impulses().ok().flatten(),
@@ -90,13 +100,17 @@ impl<M: CableModel> ClosedLoop<M> {
             limits: TensionLimits::from(&scenario.controller),
             actuation: Actuation::Controller,
             tension_sum: scenario.controller.tension_sum,
-            anchor_distance: scenario.robot.anchor_distance,
-            z_hold: None,
+            hold: None,
             feedforward,
-            rest_tensions: [0.0; 2],
+            rest_tensions: Tensions::zeros(m),
             step_start: implicit::StepStart::default(),
             residual_scratch: Default::default(),
-        }
+        })
+    }
+
+    /// The robot.
+    pub fn robot(&self) -> &Robot<D> {
+        self.model.robot()
     }
 
     /// Length of the model's part of the state.
@@ -115,12 +129,11 @@ impl<M: CableModel> ClosedLoop<M> {
         self.model_len() + self.controller_len()
     }
 
-    /// The reference at time t [s]: x, ẋ, ẍ from `step5`; z the held start height z0 (0 before
-    /// the start equilibrium is known), at rest. ẋ and ẍ are 0 for controllers that do not read
-    /// them.
+    /// The reference at time t [s]: x, ẋ, ẍ from `step5`; the other coordinates the held start
+    /// (0 before the start equilibrium is known), at rest. ẋ and ẍ are 0 for controllers that do
+    /// not read them.
     #[inline]
-    pub fn reference(&self, t: f64) -> Reference {
-        let z = self.z_hold.unwrap_or(0.0);
+    pub fn reference(&self, t: f64) -> Reference<D> {
         let step = &self.trajectory;
         let (x, v, a) = match &self.shaper {
             Some(shaper) if !shaper.is_none() => {
@@ -136,10 +149,16 @@ impl<M: CableModel> ClosedLoop<M> {
             _ if self.feedforward => (step.position(t), step.velocity(t), step.acceleration(t)),
             _ => (step.position(t), 0.0, 0.0),
         };
+        let mut position = self.hold.unwrap_or_else(Vector::zeros);
+        position[0] = x;
+        let mut velocity = Vector::zeros();
+        velocity[0] = v;
+        let mut acceleration = Vector::zeros();
+        acceleration[0] = a;
         Reference {
-            position: Vector2::new(x, z),
-            velocity: Vector2::new(v, 0.0),
-            acceleration: Vector2::new(a, 0.0),
+            position,
+            velocity,
+            acceleration,
         }
     }
 
@@ -150,7 +169,7 @@ impl<M: CableModel> ClosedLoop<M> {
 
     /// The held start height z0 [m], once [`ClosedLoop::initial_state`] has found it.
     pub fn hold_height(&self) -> Option<f64> {
-        self.z_hold
+        self.hold.map(|h| crate::robot::height(&h))
     }
 
     /// Reference, error, force and commanded tensions at (t, y).
@@ -167,19 +186,19 @@ impl<M: CableModel> ClosedLoop<M> {
     fn command_with(
         &self,
         t: f64,
-        reference: &Reference,
-        effector: &Effector,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         states: &[f64],
     ) -> Command {
         let out = self.controller.output(reference, effector, states);
         let (tensions, saturated) = match &self.actuation {
-            Actuation::Controller => self.limits.clamp(out.tensions),
+            Actuation::Controller => self.limits.clamp(&out.tensions),
             Actuation::Prescribed(f) => (f(t), false),
         };
         Command {
-            reference: reference.position.x,
-            error: reference.position.x - effector.position.x,
-            force: out.force,
+            reference: reference.position[0],
+            error: reference.position[0] - effector.position[0],
+            force: out.wrench[0],
             tensions,
             saturated,
         }
@@ -190,7 +209,7 @@ impl<M: CableModel> ClosedLoop<M> {
     fn controller_and_audit_rates(
         &self,
         y: &[f64],
-        (reference, effector): (&Reference, &Effector),
+        (reference, effector): (&Reference<D>, &Effector<D>),
         cmd: &Command,
         out: &mut [f64],
     ) {
@@ -201,12 +220,12 @@ impl<M: CableModel> ClosedLoop<M> {
         self.controller
             .state_rate(reference, effector, &y[n..n + c], cmd.saturated, rates);
         let reel = self.model.reel_speeds(model_state);
-        audits[0] = cmd.tensions[0] * reel[0] + cmd.tensions[1] * reel[1];
+        audits[0] = cmd.tensions.dot(&reel);
         audits[1] = self.model.dissipation(model_state);
     }
 }
 
-impl<M: CableModel> OdeSystem for ClosedLoop<M> {
+impl<M: CableModel<D>, const D: usize> OdeSystem for ClosedLoop<M, D> {
     fn dimension(&self) -> usize {
         self.dynamic_len() + AUDIT_STATES
     }
@@ -218,7 +237,7 @@ impl<M: CableModel> OdeSystem for ClosedLoop<M> {
         let states = &y[n..n + self.controller_len()];
         let cmd = self.command_with(t, &reference, &effector, states);
         let (model_rate, tail) = dy.split_at_mut(n);
-        self.model.rhs(t, &y[..n], cmd.tensions, model_rate);
+        self.model.rhs(t, &y[..n], &cmd.tensions, model_rate);
         self.controller_and_audit_rates(y, (&reference, &effector), &cmd, tail);
     }
 }

@@ -9,19 +9,18 @@
 //! (whose cables are massless and whose effector feels the commanded tension) when ė is measured
 //! unfiltered; on the massive cable models the cables' own dynamics are what is left over. It
 //! measures position and velocity, the velocity error through [`VelocityFilter`] (states:
-//! ∫e_x, ∫e_z, then the filter's four). Anti-windup: the integrals hold while the command is
-//! clamped.
+//! ∫e per axis, then the filter's two per axis). Anti-windup: the integrals hold while the
+//! command is clamped.
 
 use super::error_states::{self, ErrorStates};
 use super::velocity_filter::VelocityFilter;
-use super::{Controller, Measures, Output, Plant, Reference, Rest, StepStart};
-use crate::Vector2;
-use crate::model::Effector;
+use super::{Controller, Measures, Output, Reference, Rest, StepStart};
+use crate::robot::{Effector, Robot, Vector};
 use crate::scenario::{self, ControllerKind};
 
 /// Feedback linearisation with PID error dynamics.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ComputedTorque {
+pub struct ComputedTorque<const D: usize> {
     /// K_p [1/s²].
     pub kp: f64,
     /// K_d [1/s].
@@ -30,11 +29,11 @@ pub struct ComputedTorque {
     pub ki: f64,
     /// The integral and filtered-velocity error states.
     pub errors: ErrorStates,
-    pub plant: Plant,
+    pub robot: Robot<D>,
 }
 
-impl ComputedTorque {
-    pub fn new(c: &scenario::Controller, plant: Plant) -> Self {
+impl<const D: usize> ComputedTorque<D> {
+    pub fn new(c: &scenario::Controller, robot: Robot<D>) -> Self {
         Self {
             kp: c.kp,
             kd: c.kd,
@@ -44,51 +43,56 @@ impl ComputedTorque {
                     omega: c.velocity_filter,
                 },
             },
-            plant,
+            robot,
         }
     }
 
     /// The commanded acceleration a_ref + K_d ė + K_p e + K_i σ [m/s²].
     pub fn acceleration(
         &self,
-        reference: &Reference,
-        effector: &Effector,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         states: &[f64],
-    ) -> Vector2<f64> {
+    ) -> Vector<D> {
         let e = reference.position - effector.position;
         let de = self.errors.velocity_error(reference, effector, states);
-        let sigma = ErrorStates::integral(states);
+        let sigma = ErrorStates::integral::<D>(states);
         reference.acceleration + self.kd * de + self.kp * e + self.ki * sigma
     }
 }
 
-impl Controller for ComputedTorque {
+impl<const D: usize> Controller<D> for ComputedTorque<D> {
     fn kind(&self) -> ControllerKind {
         ControllerKind::ComputedTorque
     }
     fn state_len(&self) -> usize {
-        error_states::STATES
+        error_states::states::<D>()
     }
     fn uses_reference_derivatives(&self) -> bool {
         true
     }
     fn measures(&self) -> Measures {
         Measures {
-            z: true,
+            all_axes: true,
             velocity: true,
         }
     }
-    fn output(&self, reference: &Reference, effector: &Effector, states: &[f64]) -> Output {
+    fn output(
+        &self,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
+        states: &[f64],
+    ) -> Output<D> {
         let a = self.acceleration(reference, effector, states);
         Output {
-            force: self.plant.effector_mass * a.x,
-            tensions: self.plant.tensions_for_acceleration(effector.position, a),
+            wrench: self.robot.effector_mass * a,
+            tensions: super::tensions_for_acceleration(&self.robot, &effector.position, &a),
         }
     }
     fn state_rate(
         &self,
-        reference: &Reference,
-        effector: &Effector,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         states: &[f64],
         saturated: bool,
         rate: &mut [f64],
@@ -99,21 +103,21 @@ impl Controller for ComputedTorque {
     fn trapezoidal_step(
         &self,
         h: f64,
-        start: &StepStart,
-        reference: &Reference,
-        effector: &Effector,
+        start: &StepStart<D>,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         out: &mut [f64],
     ) {
         self.errors
             .trapezoidal_step(h, start, reference, effector, out);
     }
-    fn rest_states(&self, _: &Reference, effector: &Effector, rest: &Rest, out: &mut [f64]) {
+    fn rest_states(&self, _: &Reference<D>, effector: &Effector<D>, rest: &Rest, out: &mut [f64]) {
         // At rest the integral supplies what the rigid-cable statics miss (the cables' weight).
-        let a = self.plant.acceleration(effector.position, rest.tensions);
+        let a = super::acceleration(&self.robot, &effector.position, &rest.tensions);
         let sigma = if self.ki > 0.0 {
             a / self.ki
         } else {
-            Vector2::zeros()
+            Vector::zeros()
         };
         ErrorStates::rest(sigma, out);
     }

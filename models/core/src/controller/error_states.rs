@@ -1,14 +1,15 @@
 //! The states computed-torque and the LQR share: the integral of the position error σ = ∫e dt
 //! (held while the command is clamped: conditional integration) and the low-passed velocity
-//! error ([`VelocityFilter`]). Layout: [σ_x, σ_z, then the filter's four].
+//! error ([`VelocityFilter`]). Layout: [σ per axis, then the filter's 2 per axis].
 
 use super::velocity_filter::{self, VelocityFilter};
 use super::{Reference, StepStart};
-use crate::Vector2;
-use crate::model::Effector;
+use crate::robot::{Effector, Vector};
 
-/// Number of states: two integrals and the filter's.
-pub const STATES: usize = 2 + velocity_filter::STATES;
+/// Number of states of a robot in D dimensions: D integrals and the filter's 2 D.
+pub const fn states<const D: usize>() -> usize {
+    D + velocity_filter::STATES_PER_AXIS * D
+}
 
 /// The integral and filtered-velocity error states.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -18,29 +19,26 @@ pub struct ErrorStates {
 
 impl ErrorStates {
     /// σ = ∫e dt [m s].
-    pub fn integral(states: &[f64]) -> Vector2<f64> {
-        Vector2::new(states[0], states[1])
+    pub fn integral<const D: usize>(states: &[f64]) -> Vector<D> {
+        Vector::from_fn(|k, _| states[k])
     }
 
     /// The velocity error ė [m/s] the controller acts on: filtered, or raw when the filter is off.
-    pub fn velocity_error(
+    pub fn velocity_error<const D: usize>(
         &self,
-        reference: &Reference,
-        effector: &Effector,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         states: &[f64],
-    ) -> Vector2<f64> {
+    ) -> Vector<D> {
         let raw = reference.velocity - effector.velocity;
-        Vector2::new(
-            self.filter.output(&states[2..], 0, raw.x),
-            self.filter.output(&states[2..], 1, raw.y),
-        )
+        Vector::from_fn(|k, _| self.filter.output(&states[D..], k, raw[k]))
     }
 
     /// d/dt of the states; the integrals hold while `saturated`.
-    pub fn rate(
+    pub fn rate<const D: usize>(
         &self,
-        reference: &Reference,
-        effector: &Effector,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         states: &[f64],
         saturated: bool,
         rate: &mut [f64],
@@ -48,24 +46,26 @@ impl ErrorStates {
         let e = reference.position - effector.position;
         let de = reference.velocity - effector.velocity;
         let gate = if saturated { 0.0 } else { 1.0 };
-        rate[0] = gate * e.x;
-        rate[1] = gate * e.y;
-        self.filter.rate(&states[2..], [de.x, de.y], &mut rate[2..]);
+        for k in 0..D {
+            rate[k] = gate * e[k];
+        }
+        self.filter
+            .rate(&states[D..], de.as_slice(), &mut rate[D..]);
     }
 
     /// The trapezoidal step of size h [s] from `start` to the reference and effector at its end;
     /// the integrals hold if the command was clamped at the start.
-    pub fn trapezoidal_step(
+    pub fn trapezoidal_step<const D: usize>(
         &self,
         h: f64,
-        start: &StepStart,
-        reference: &Reference,
-        effector: &Effector,
+        start: &StepStart<D>,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         out: &mut [f64],
     ) {
         let e0 = start.reference.position - start.effector.position;
         let e1 = reference.position - effector.position;
-        for k in 0..2 {
+        for k in 0..D {
             out[k] = if start.saturated {
                 start.states[k]
             } else {
@@ -75,18 +75,17 @@ impl ErrorStates {
         let de0 = start.reference.velocity - start.effector.velocity;
         let de1 = reference.velocity - effector.velocity;
         self.filter.trapezoidal_step(
-            &start.states[2..],
-            [de0.x, de0.y],
-            [de1.x, de1.y],
+            &start.states[D..],
+            de0.as_slice(),
+            de1.as_slice(),
             h,
-            &mut out[2..],
+            &mut out[D..],
         );
     }
 
     /// The rest: integrals `sigma`, filter at zero.
-    pub fn rest(sigma: Vector2<f64>, out: &mut [f64]) {
-        out[0] = sigma.x;
-        out[1] = sigma.y;
-        out[2..STATES].fill(0.0);
+    pub fn rest<const D: usize>(sigma: Vector<D>, out: &mut [f64]) {
+        out[..D].copy_from_slice(sigma.as_slice());
+        out[D..states::<D>()].fill(0.0);
     }
 }

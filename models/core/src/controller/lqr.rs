@@ -1,4 +1,4 @@
-//! `lqr`: linear-quadratic state feedback with integral action on x and z, designed on the
+//! `lqr`: linear-quadratic state feedback with integral action on every axis, designed on the
 //! linearisation of the elastic loop (rigid massless cables) at the move's end point (x2, z0):
 //!
 //! ```text
@@ -13,47 +13,49 @@
 //! T = W(p_ref)⁻¹ M (a_ref − g) + K (e, ė, ∫e),  e = p_ref − p. Q = diag(q_position I,
 //! q_velocity I, q_integral I), R = r I. The velocity error is measured through
 //! [`VelocityFilter`] (the design ignores the filter: its corner lies far above the loop's
-//! poles). Anti-windup: the integrals hold while the command is clamped.
+//! poles). Anti-windup: the integrals hold while the command is clamped. The design needs as many
+//! cables as axes (W* square); a redundant robot's LQR designs through its tension distribution.
 
 use super::error_states::{self, ErrorStates};
 use super::velocity_filter::VelocityFilter;
 use super::{
-    ControlError, Controller, Measures, Output, Plant, Reference, Rest, StepStart,
-    geometric_stiffness, structure_matrix,
+    ControlError, Controller, Measures, Output, Reference, Rest, StepStart,
+    tensions_for_acceleration,
 };
-use crate::Vector2;
-use crate::model::Effector;
+use crate::robot::{Effector, Matrix, Robot, Tensions, Vector, vertical};
 use crate::scenario::{ControllerKind, Scenario};
-use nalgebra::{Matrix2, SMatrix};
-
-/// Number of design states ξ = (δx, δz, δẋ, δż, σx, σz).
-pub const DESIGN_STATES: usize = 6;
 
 /// The LQR design and controller.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Lqr {
-    /// K (2 × 6) on ξ = (e, ė, ∫e) [N/m, N s/m, N/(m s)].
-    pub gain: SMatrix<f64, 2, DESIGN_STATES>,
-    /// The design point (x2, z) [m].
-    pub design_point: Vector2<f64>,
+pub struct Lqr<const D: usize> {
+    /// K (m × 3D, row-major) on ξ = (e, ė, ∫e) [N/m, N s/m, N/(m s)].
+    pub gain: Vec<f64>,
+    /// The design point (x2, z0) [m].
+    pub design_point: Vector<D>,
     /// max |residual| of the CARE at the returned X.
     pub care_residual: f64,
-    pub plant: Plant,
+    pub robot: Robot<D>,
     /// The integral and filtered-velocity error states.
     pub errors: ErrorStates,
     weights: [f64; 4],
 }
 
-impl Lqr {
+impl<const D: usize> Lqr<D> {
+    /// Number of design states ξ = (δp, δṗ, σ).
+    pub const DESIGN_STATES: usize = 3 * D;
+
     /// Not yet designed (K = 0): the design point's height is the start equilibrium's z0,
     /// which the closed loop passes to [`Controller::hold_height`] before any run.
-    pub fn new(scenario: &Scenario, plant: Plant) -> Self {
+    pub fn new(scenario: &Scenario, robot: Robot<D>) -> Self {
         let c = &scenario.controller;
+        let mut design_point = Vector::zeros();
+        design_point[0] = scenario.trajectory.x2;
+        design_point[vertical::<D>()] = f64::NAN;
         Self {
-            gain: SMatrix::zeros(),
-            design_point: Vector2::new(scenario.trajectory.x2, f64::NAN),
+            gain: vec![0.0; robot.cables() * Self::DESIGN_STATES],
+            design_point,
             care_residual: f64::NAN,
-            plant,
+            robot,
             errors: ErrorStates {
                 filter: VelocityFilter {
                     omega: c.velocity_filter,
@@ -69,21 +71,24 @@ impl Lqr {
         Ok(self)
     }
 
-    /// The linearised plant (A, B) at the design point, row-major.
-    pub fn linearisation(&self) -> ([f64; 36], [f64; 12]) {
-        let p = &self.plant;
+    /// The linearised plant (A, B) at the design point, row-major: A is 3D × 3D, B 3D × m.
+    pub fn linearisation(&self) -> (Vec<f64>, Vec<f64>) {
+        let r = &self.robot;
         let pd = self.design_point;
-        let w = structure_matrix(pd, p.anchor_distance);
-        let hold = p.tensions_for_acceleration(pd, Vector2::zeros());
-        let g: Matrix2<f64> = geometric_stiffness(pd, p.anchor_distance, hold) / p.effector_mass;
-        let mut a = [0.0; 36];
-        let mut b = [0.0; 12];
-        for i in 0..2 {
-            a[i * 6 + 2 + i] = 1.0; // δṗ = δv
-            a[(4 + i) * 6 + i] = 1.0; // σ̇ = δp
-            for j in 0..2 {
-                a[(2 + i) * 6 + j] = g[(i, j)];
-                b[(2 + i) * 2 + j] = w[(i, j)] / p.effector_mass;
+        let (n, m) = (Self::DESIGN_STATES, r.cables());
+        let w = r.structure_matrix(&pd);
+        let hold = tensions_for_acceleration(r, &pd, &Vector::zeros());
+        let g: Matrix<D> = r.geometric_stiffness(&pd, &hold) / r.effector_mass;
+        let mut a = vec![0.0; n * n];
+        let mut b = vec![0.0; n * m];
+        for i in 0..D {
+            a[i * n + D + i] = 1.0; // δṗ = δv
+            a[(2 * D + i) * n + i] = 1.0; // σ̇ = δp
+            for j in 0..D {
+                a[(D + i) * n + j] = g[(i, j)];
+            }
+            for j in 0..m {
+                b[(D + i) * m + j] = w.column(j)[i] / r.effector_mass;
             }
         }
         (a, b)
@@ -91,65 +96,103 @@ impl Lqr {
 
     /// Solves the CARE at the design point.
     pub fn design(&mut self) -> Result<(), ControlError> {
+        let (n, m) = (Self::DESIGN_STATES, self.robot.cables());
+        let error = |why: String| ControlError::Design {
+            point: self.design_point.iter().copied().collect(),
+            why,
+        };
+        if m != D {
+            return Err(error(format!(
+                "{m} cables on {D} axes: this design needs as many cables as axes"
+            )));
+        }
         let (a, b) = self.linearisation();
         let [qp, qv, qi, r] = self.weights;
-        let mut q = [0.0; 36];
-        for (k, w) in [qp, qp, qv, qv, qi, qi].into_iter().enumerate() {
-            q[k * 6 + k] = w;
+        let mut q = vec![0.0; n * n];
+        for k in 0..n {
+            q[k * n + k] = [qp, qv, qi][k / D];
         }
-        let r = [r, 0.0, 0.0, r];
-        let (gain, residual, _) =
-            cdpr_numerics::riccati::lqr_gain(6, 2, &a, &b, &q, &r).map_err(|e| {
-                ControlError::Design {
-                    x: self.design_point.x,
-                    z: self.design_point.y,
-                    why: e.to_string(),
-                }
-            })?;
-        self.gain = SMatrix::from_row_slice(&gain);
+        let mut rr = vec![0.0; m * m];
+        for k in 0..m {
+            rr[k * m + k] = r;
+        }
+        let (gain, residual, _) = cdpr_numerics::riccati::lqr_gain(n, m, &a, &b, &q, &rr)
+            .map_err(|e| error(e.to_string()))?;
+        self.gain = gain;
         self.care_residual = residual;
         Ok(())
     }
 
-    fn xi(&self, reference: &Reference, effector: &Effector, states: &[f64]) -> SMatrix<f64, 6, 1> {
+    /// ξ = (e, ė, σ).
+    fn xi(
+        &self,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
+        states: &[f64],
+        out: &mut [f64],
+    ) {
         let e = reference.position - effector.position;
         let de = self.errors.velocity_error(reference, effector, states);
-        SMatrix::<f64, 6, 1>::from([e.x, e.y, de.x, de.y, states[0], states[1]])
+        for k in 0..D {
+            out[k] = e[k];
+            out[D + k] = de[k];
+            out[2 * D + k] = states[k];
+        }
+    }
+
+    /// K ξ, each row summed from its first column (the order of nalgebra's matrix-vector
+    /// product, so the plane's runs keep their bits).
+    fn feedback(&self, xi: &[f64]) -> Tensions {
+        let n = Self::DESIGN_STATES;
+        Tensions::from_fn(self.robot.cables(), |i| {
+            let row = &self.gain[i * n..(i + 1) * n];
+            let mut sum = row[0] * xi[0];
+            for j in 1..n {
+                sum += row[j] * xi[j];
+            }
+            sum
+        })
     }
 }
 
-impl Controller for Lqr {
+impl<const D: usize> Controller<D> for Lqr<D> {
     fn kind(&self) -> ControllerKind {
         ControllerKind::Lqr
     }
     fn state_len(&self) -> usize {
-        error_states::STATES
+        error_states::states::<D>()
     }
     fn uses_reference_derivatives(&self) -> bool {
         true
     }
     fn measures(&self) -> Measures {
         Measures {
-            z: true,
+            all_axes: true,
             velocity: true,
         }
     }
-    fn output(&self, reference: &Reference, effector: &Effector, states: &[f64]) -> Output {
-        let ff = self
-            .plant
-            .tensions_for_acceleration(reference.position, reference.acceleration);
-        let dt = self.gain * self.xi(reference, effector, states);
-        let tensions = [ff[0] + dt[0], ff[1] + dt[1]];
-        let w = structure_matrix(effector.position, self.plant.anchor_distance);
+    fn output(
+        &self,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
+        states: &[f64],
+    ) -> Output<D> {
+        let ff =
+            tensions_for_acceleration(&self.robot, &reference.position, &reference.acceleration);
+        let mut xi = [0.0; 3 * crate::robot::MAX_AXES];
+        self.xi(reference, effector, states, &mut xi);
+        let dt = self.feedback(&xi);
+        let tensions = Tensions::from_fn(ff.len(), |i| ff[i] + dt[i]);
+        let w = self.robot.structure_matrix(&effector.position);
         Output {
-            force: (w * Vector2::new(tensions[0], tensions[1])).x,
+            wrench: w.force(&tensions),
             tensions,
         }
     }
     fn state_rate(
         &self,
-        reference: &Reference,
-        effector: &Effector,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         states: &[f64],
         saturated: bool,
         rate: &mut [f64],
@@ -160,36 +203,39 @@ impl Controller for Lqr {
     fn trapezoidal_step(
         &self,
         h: f64,
-        start: &StepStart,
-        reference: &Reference,
-        effector: &Effector,
+        start: &StepStart<D>,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         out: &mut [f64],
     ) {
         self.errors
             .trapezoidal_step(h, start, reference, effector, out);
     }
-    fn rest_states(&self, reference: &Reference, _: &Effector, rest: &Rest, out: &mut [f64]) {
+    fn rest_states(&self, reference: &Reference<D>, _: &Effector<D>, rest: &Rest, out: &mut [f64]) {
         // K_σ σ = T_rest − T_ff at zero error.
-        let ff = self
-            .plant
-            .tensions_for_acceleration(reference.position, Vector2::zeros());
-        let k_sigma = self.gain.fixed_view::<2, 2>(0, 4).into_owned();
-        let need = Vector2::new(rest.tensions[0] - ff[0], rest.tensions[1] - ff[1]);
-        let sigma = k_sigma
-            .try_inverse()
-            .map_or(Vector2::zeros(), |inv| inv * need);
+        let ff = tensions_for_acceleration(&self.robot, &reference.position, &Vector::zeros());
+        let n = Self::DESIGN_STATES;
+        let sigma = if self.robot.cables() == D {
+            let k_sigma = Matrix::<D>::from_fn(|i, j| self.gain[i * n + 2 * D + j]);
+            let need = Vector::<D>::from_fn(|i, _| rest.tensions[i] - ff[i]);
+            k_sigma
+                .try_inverse()
+                .map_or(Vector::zeros(), |inv| inv * need)
+        } else {
+            Vector::zeros()
+        };
         ErrorStates::rest(sigma, out);
     }
     fn hold_height(&mut self, z0: f64) -> Result<(), ControlError> {
-        self.design_point.y = z0;
+        self.design_point[vertical::<D>()] = z0;
         self.design()
     }
     fn gains(&self) -> Vec<(&'static str, Vec<f64>)> {
         vec![
-            ("lqr_gain", self.gain.transpose().iter().copied().collect()),
+            ("lqr_gain", self.gain.clone()),
             (
                 "lqr_design_point",
-                vec![self.design_point.x, self.design_point.y],
+                self.design_point.iter().copied().collect(),
             ),
             ("care_residual", vec![self.care_residual]),
         ]

@@ -1,7 +1,44 @@
-//! Controllers: from the reference, the measured effector state (x, z, ẋ, ż) and the
-//! controller's own states, the commanded tensions [T1, T2]. They know nothing of cable models;
-//! the closed loop ([`crate::closed_loop`]) integrates their states with the model's, clamps their
-//! tensions to the limits and tells them when it did (anti-windup).
+//! Controllers: from the reference, the measured effector state (position and velocity) and the
+//! controller's own states, the wrench asked of the cables and the commanded tensions T_1 … T_m.
+//! They know nothing of cable models; the closed loop ([`crate::closed_loop`]) integrates their
+//! states with the model's, clamps their tensions to the limits and tells them when it did
+//! (anti-windup). The robot's space is the type parameter D.
+//!
+//! # Examples
+//!
+//! A controller of one's own: a proportional pull on x with ΣT fixed, split as the paper's PID
+//! splits it (no states of its own).
+//!
+//! ```
+//! use cdpr_core::controller::{Controller, Measures, Output, Reference, Rest, StepStart, split_tensions};
+//! use cdpr_core::robot::{Effector, Tensions, Vector};
+//! use cdpr_core::scenario::ControllerKind;
+//!
+//! #[derive(Debug)]
+//! struct Spring { gain: f64, tension_sum: f64 }
+//!
+//! impl Controller<2> for Spring {
+//!     fn kind(&self) -> ControllerKind { ControllerKind::Pid }
+//!     fn state_len(&self) -> usize { 0 }
+//!     fn measures(&self) -> Measures { Measures { all_axes: false, velocity: false } }
+//!     fn output(&self, reference: &Reference<2>, effector: &Effector<2>, _: &[f64]) -> Output<2> {
+//!         let force = self.gain * (reference.position.x - effector.position.x);
+//!         Output {
+//!             wrench: Vector::<2>::new(force, 0.0),
+//!             tensions: Tensions::pair(split_tensions(self.tension_sum, force)),
+//!         }
+//!     }
+//!     fn state_rate(&self, _: &Reference<2>, _: &Effector<2>, _: &[f64], _: bool, _: &mut [f64]) {}
+//!     fn trapezoidal_step(&self, _: f64, _: &StepStart<2>, _: &Reference<2>, _: &Effector<2>, _: &mut [f64]) {}
+//!     fn rest_states(&self, _: &Reference<2>, _: &Effector<2>, _: &Rest, _: &mut [f64]) {}
+//! }
+//!
+//! let c = Spring { gain: 1000.0, tension_sum: 200.0 };
+//! let reference = Reference { position: Vector::<2>::new(0.6, -0.02), ..Reference::default() };
+//! let effector = Effector { position: Vector::<2>::new(0.5, -0.02), velocity: Vector::zeros() };
+//! let out = c.output(&reference, &effector, &[]);
+//! assert!((out.tensions[1] - out.tensions[0] - 100.0).abs() < 1e-12, "F = 100 N toward A2");
+//! ```
 //!
 //! | kind | file | acts on | states |
 //! |---|---|---|---|
@@ -18,74 +55,83 @@ pub mod pid;
 pub mod pid_xz;
 pub mod velocity_filter;
 
-pub use distribution::{
-    TensionDistribution, TensionLimits, geometric_stiffness, split_tensions, structure_matrix,
-    tensions_for_force,
-};
+pub use distribution::{TensionDistribution, TensionLimits, split_tensions};
 pub use pid::{PaperPid, Pid, PidState};
 
-use crate::Vector2;
-use crate::model::Effector;
+use crate::robot::{Effector, Robot, Tensions, Vector, along_vertical};
 use crate::scenario::{ControllerKind, Scenario};
 
 /// The reference at one instant: position, velocity and acceleration [m, m/s, m/s²] of the
-/// effector (x from `step5`; z the held start height, or z0 where z is free).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Reference {
-    pub position: Vector2<f64>,
-    pub velocity: Vector2<f64>,
-    pub acceleration: Vector2<f64>,
+/// effector (x from `step5`; the other coordinates the held start, or the start where they are
+/// free).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reference<const D: usize> {
+    pub position: Vector<D>,
+    pub velocity: Vector<D>,
+    pub acceleration: Vector<D>,
+}
+
+impl<const D: usize> Default for Reference<D> {
+    fn default() -> Self {
+        Self {
+            position: Vector::zeros(),
+            velocity: Vector::zeros(),
+            acceleration: Vector::zeros(),
+        }
+    }
 }
 
 /// What a controller asks for at one instant, before the tension limits.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Output {
-    /// The horizontal force the controller asks of the cables [N] (the paper's F; for the
-    /// controllers acting through W, the x component of the desired force).
-    pub force: f64,
-    /// Commanded tensions [T1, T2] [N], unclamped.
-    pub tensions: [f64; 2],
+pub struct Output<const D: usize> {
+    /// The force the controller asks of the cables on the effector [N]. The paper's PID asks
+    /// for the horizontal F only (its split fixes ΣT instead of a vertical force): the other
+    /// components are 0 for it.
+    pub wrench: Vector<D>,
+    /// Commanded tensions T_1 … T_m [N], unclamped.
+    pub tensions: Tensions,
 }
 
 /// The rest the controller must hold at a run's start or a linearisation point: the model's
 /// static equilibrium's tensions and the paper PID's force F0 (T2 − T1 in exact arithmetic).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Rest {
-    pub tensions: [f64; 2],
+    pub tensions: Tensions,
     pub force: f64,
 }
 
 /// The start of an implicit step as a controller sees it.
 #[derive(Debug, Clone, Copy)]
-pub struct StepStart<'a> {
-    pub reference: Reference,
-    pub effector: Effector,
+pub struct StepStart<'a, const D: usize> {
+    pub reference: Reference<D>,
+    pub effector: Effector<D>,
     pub states: &'a [f64],
     /// Whether the command was clamped at the step's start (anti-windup holds the integrals).
     pub saturated: bool,
 }
 
-/// A controller of the two-cable robot. Implementations are pure functions of their inputs.
-pub trait Controller: Send + Sync + std::fmt::Debug {
+/// A controller of a robot in D dimensions. Implementations are pure functions of their inputs.
+pub trait Controller<const D: usize>: Send + Sync + std::fmt::Debug {
     /// Which controller this is.
     fn kind(&self) -> ControllerKind;
 
     /// Number of the controller's own states.
     fn state_len(&self) -> usize;
 
-    /// Whether the tensions depend on the effector's z, and on its velocity (the implicit
-    /// iteration matrix then has those columns).
+    /// Which of the effector's coordinates the tensions depend on besides x, and whether on its
+    /// velocity (the implicit iteration matrix then has those columns).
     fn measures(&self) -> Measures;
 
-    /// The force and tensions for `reference`, the measured `effector` and the `states`.
-    fn output(&self, reference: &Reference, effector: &Effector, states: &[f64]) -> Output;
+    /// The wrench and tensions for `reference`, the measured `effector` and the `states`.
+    fn output(&self, reference: &Reference<D>, effector: &Effector<D>, states: &[f64])
+    -> Output<D>;
 
     /// d/dt of the states (`rate`, [`Controller::state_len`] long); `saturated`: the command is
     /// clamped (anti-windup).
     fn state_rate(
         &self,
-        reference: &Reference,
-        effector: &Effector,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         states: &[f64],
         saturated: bool,
         rate: &mut [f64],
@@ -97,15 +143,21 @@ pub trait Controller: Send + Sync + std::fmt::Debug {
     fn trapezoidal_step(
         &self,
         h: f64,
-        start: &StepStart,
-        reference: &Reference,
-        effector: &Effector,
+        start: &StepStart<D>,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         out: &mut [f64],
     );
 
     /// States that command the `rest` tensions at zero error and rest (zero where the controller
     /// has no integral action to hold them).
-    fn rest_states(&self, reference: &Reference, effector: &Effector, rest: &Rest, out: &mut [f64]);
+    fn rest_states(
+        &self,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
+        rest: &Rest,
+        out: &mut [f64],
+    );
 
     /// Whether the controller reads the reference's velocity and acceleration (feedforward);
     /// the loop skips computing them otherwise (the elastic RHS is ~15 ns: it shows).
@@ -134,62 +186,55 @@ pub trait Controller: Send + Sync + std::fmt::Debug {
 /// What a controller's tensions depend on besides the effector's x.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Measures {
-    pub z: bool,
+    /// Every coordinate of the effector (the vertical, and y in space), not only x.
+    pub all_axes: bool,
     pub velocity: bool,
 }
 
 /// Why a controller could not be designed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ControlError {
-    #[error("LQR design at (x, z) = ({x}, {z}) m failed: {why}")]
-    Design { x: f64, z: f64, why: String },
+    #[error("LQR design at {point:?} m failed: {why}")]
+    Design { point: Vec<f64>, why: String },
 }
 
-/// The robot as the controllers see it: rigid massless cables from pulleys A1 = (0, 0) and
-/// A2 = (d, 0) to an effector of mass M under gravity g.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Plant {
-    pub anchor_distance: f64,
-    pub effector_mass: f64,
-    pub gravity: f64,
+/// Tensions that give the effector at `p` the acceleration `a` [m/s²] on rigid massless
+/// cables: M a = W T + M g⃗ ⇒ T = W⁻¹ M (a − g⃗) (robots with as many cables as axes; NaN
+/// tensions otherwise, which the runner refuses).
+pub fn tensions_for_acceleration<const D: usize>(
+    robot: &Robot<D>,
+    p: &Vector<D>,
+    a: &Vector<D>,
+) -> Tensions {
+    let v = crate::robot::vertical::<D>();
+    let mut lift = *a;
+    lift[v] = a[v] + robot.gravity;
+    let force = lift * robot.effector_mass;
+    robot
+        .tensions_for_force(p, &force)
+        .unwrap_or_else(|| Tensions::from_fn(robot.cables(), |_| f64::NAN))
 }
 
-impl Plant {
-    pub fn new(scenario: &Scenario) -> Self {
-        Self {
-            anchor_distance: scenario.robot.anchor_distance,
-            effector_mass: scenario.robot.effector_mass,
-            gravity: scenario.robot.gravity,
-        }
-    }
-
-    /// Tensions that give the effector at `p` the acceleration `a` [m/s²] on rigid massless
-    /// cables: M a = W T + M g ⇒ T = W⁻¹ M (a − g), g = (0, −g).
-    pub fn tensions_for_acceleration(&self, p: Vector2<f64>, a: Vector2<f64>) -> [f64; 2] {
-        let force = self.effector_mass * Vector2::new(a.x, a.y + self.gravity);
-        tensions_for_force(p, self.anchor_distance, force)
-    }
-
-    /// The acceleration [m/s²] the tensions give the effector at `p` on rigid massless cables.
-    pub fn acceleration(&self, p: Vector2<f64>, tensions: [f64; 2]) -> Vector2<f64> {
-        let w = structure_matrix(p, self.anchor_distance);
-        w * Vector2::new(tensions[0], tensions[1]) / self.effector_mass
-            - Vector2::new(0.0, self.gravity)
-    }
+/// The acceleration [m/s²] the tensions give the effector at `p` on rigid massless cables.
+pub fn acceleration<const D: usize>(
+    robot: &Robot<D>,
+    p: &Vector<D>,
+    tensions: &[f64],
+) -> Vector<D> {
+    robot.structure_matrix(p).force(tensions) / robot.effector_mass - along_vertical(robot.gravity)
 }
 
-/// The scenario's controller. A controller designed at the held height (the LQR) is designed
-/// when the closed loop knows it ([`Controller::hold_height`]).
-pub fn build(scenario: &Scenario) -> AnyController {
+/// The scenario's controller for `robot`. A controller designed at the held height (the LQR) is
+/// designed when the closed loop knows it ([`Controller::hold_height`]).
+pub fn build<const D: usize>(scenario: &Scenario, robot: Robot<D>) -> AnyController<D> {
     let c = &scenario.controller;
-    let plant = Plant::new(scenario);
     match c.kind {
         ControllerKind::Pid => AnyController::Pid(PaperPid::from(c)),
-        ControllerKind::PidXz => AnyController::PidXz(pid_xz::PidXz::new(c, plant)),
+        ControllerKind::PidXz => AnyController::PidXz(pid_xz::PidXz::new(c, robot)),
         ControllerKind::ComputedTorque => {
-            AnyController::ComputedTorque(computed_torque::ComputedTorque::new(c, plant))
+            AnyController::ComputedTorque(computed_torque::ComputedTorque::new(c, robot))
         }
-        ControllerKind::Lqr => AnyController::Lqr(Box::new(lqr::Lqr::new(scenario, plant))),
+        ControllerKind::Lqr => AnyController::Lqr(lqr::Lqr::new(scenario, robot)),
     }
 }
 
@@ -197,14 +242,15 @@ pub fn build(scenario: &Scenario) -> AnyController {
 /// is ~15 ns, and the compiler inlines the paper PID's arithmetic through the match (a boxed
 /// trait object cost 7.6 ns per RHS, 12.8 → 20.4 ns).
 #[derive(Debug, Clone)]
-pub enum AnyController {
+pub enum AnyController<const D: usize> {
     Pid(PaperPid),
-    PidXz(pid_xz::PidXz),
-    ComputedTorque(computed_torque::ComputedTorque),
-    Lqr(Box<lqr::Lqr>),
+    PidXz(pid_xz::PidXz<D>),
+    ComputedTorque(computed_torque::ComputedTorque<D>),
+    Lqr(lqr::Lqr<D>),
 }
 
-macro_rules! each {
+/// `$body` with `$c` bound to the controller inside `$self`, whichever it is.
+macro_rules! dispatch {
     ($self:expr, $c:ident => $body:expr) => {
         match $self {
             AnyController::Pid($c) => $body,
@@ -215,60 +261,65 @@ macro_rules! each {
     };
 }
 
-impl Controller for AnyController {
+impl<const D: usize> Controller<D> for AnyController<D> {
     fn kind(&self) -> ControllerKind {
-        each!(self, c => c.kind())
+        dispatch!(self, c => Controller::<D>::kind(c))
     }
     fn state_len(&self) -> usize {
-        each!(self, c => c.state_len())
+        dispatch!(self, c => Controller::<D>::state_len(c))
     }
     fn measures(&self) -> Measures {
-        each!(self, c => c.measures())
+        dispatch!(self, c => Controller::<D>::measures(c))
     }
     #[inline]
-    fn output(&self, reference: &Reference, effector: &Effector, states: &[f64]) -> Output {
-        each!(self, c => c.output(reference, effector, states))
+    fn output(
+        &self,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
+        states: &[f64],
+    ) -> Output<D> {
+        dispatch!(self, c => c.output(reference, effector, states))
     }
     #[inline]
     fn state_rate(
         &self,
-        reference: &Reference,
-        effector: &Effector,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         states: &[f64],
         saturated: bool,
         rate: &mut [f64],
     ) {
-        each!(self, c => c.state_rate(reference, effector, states, saturated, rate))
+        dispatch!(self, c => c.state_rate(reference, effector, states, saturated, rate))
     }
     fn trapezoidal_step(
         &self,
         h: f64,
-        start: &StepStart,
-        reference: &Reference,
-        effector: &Effector,
+        start: &StepStart<D>,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         out: &mut [f64],
     ) {
-        each!(self, c => c.trapezoidal_step(h, start, reference, effector, out))
+        dispatch!(self, c => c.trapezoidal_step(h, start, reference, effector, out))
     }
     fn rest_states(
         &self,
-        reference: &Reference,
-        effector: &Effector,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         rest: &Rest,
         out: &mut [f64],
     ) {
-        each!(self, c => c.rest_states(reference, effector, rest, out))
+        dispatch!(self, c => c.rest_states(reference, effector, rest, out))
     }
     fn uses_reference_derivatives(&self) -> bool {
-        each!(self, c => c.uses_reference_derivatives())
+        dispatch!(self, c => Controller::<D>::uses_reference_derivatives(c))
     }
     fn difference_step(&self) -> f64 {
-        each!(self, c => c.difference_step())
+        dispatch!(self, c => Controller::<D>::difference_step(c))
     }
     fn hold_height(&mut self, z0: f64) -> Result<(), ControlError> {
-        each!(self, c => c.hold_height(z0))
+        dispatch!(self, c => Controller::<D>::hold_height(c, z0))
     }
     fn gains(&self) -> Vec<(&'static str, Vec<f64>)> {
-        each!(self, c => c.gains())
+        dispatch!(self, c => Controller::<D>::gains(c))
     }
 }

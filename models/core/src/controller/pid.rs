@@ -7,7 +7,7 @@
 //! model, so its transfer function C(s) = P + I/s + D N_f s/(s + N_f) holds exactly.
 
 use super::{Controller, Measures, Output, Reference, Rest, StepStart, split_tensions};
-use crate::model::Effector;
+use crate::robot::{Effector, Tensions, Vector};
 use crate::scenario::{self, ControllerKind};
 
 /// PID with derivative filter, Simulink parallel form: C(s) = P + I/s + D·N_f·s/(s + N_f).
@@ -111,7 +111,7 @@ impl From<&scenario::Controller> for PaperPid {
     }
 }
 
-impl Controller for PaperPid {
+impl<const D: usize> Controller<D> for PaperPid {
     fn kind(&self) -> ControllerKind {
         ControllerKind::Pid
     }
@@ -120,29 +120,36 @@ impl Controller for PaperPid {
     }
     fn measures(&self) -> Measures {
         Measures {
-            z: false,
+            all_axes: false,
             velocity: false,
         }
     }
     #[inline]
-    fn output(&self, reference: &Reference, effector: &Effector, states: &[f64]) -> Output {
-        let error = reference.position.x - effector.position.x;
+    fn output(
+        &self,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
+        states: &[f64],
+    ) -> Output<D> {
+        let error = reference.position[0] - effector.position[0];
         let force = self.pid.force(error, PidState::of(states));
+        let mut wrench = Vector::zeros();
+        wrench[0] = force;
         Output {
-            force,
-            tensions: split_tensions(self.tension_sum, force),
+            wrench,
+            tensions: Tensions::pair(split_tensions(self.tension_sum, force)),
         }
     }
     /// The paper's PID has no anti-windup: `saturated` is ignored.
     fn state_rate(
         &self,
-        reference: &Reference,
-        effector: &Effector,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         states: &[f64],
         _saturated: bool,
         rate: &mut [f64],
     ) {
-        let error = reference.position.x - effector.position.x;
+        let error = reference.position[0] - effector.position[0];
         let r = self.pid.state_rate(error, PidState::of(states));
         rate[0] = r.integral;
         rate[1] = r.filter;
@@ -150,20 +157,20 @@ impl Controller for PaperPid {
     fn trapezoidal_step(
         &self,
         h: f64,
-        start: &StepStart,
-        reference: &Reference,
-        effector: &Effector,
+        start: &StepStart<D>,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         out: &mut [f64],
     ) {
-        let e_start = start.reference.position.x - start.effector.position.x;
-        let e_end = reference.position.x - effector.position.x;
+        let e_start = start.reference.position[0] - start.effector.position[0];
+        let e_end = reference.position[0] - effector.position[0];
         let s = self
             .pid
             .trapezoidal_step(PidState::of(start.states), e_start, e_end, h);
         out[0] = s.integral;
         out[1] = s.filter;
     }
-    fn rest_states(&self, _: &Reference, _: &Effector, rest: &Rest, out: &mut [f64]) {
+    fn rest_states(&self, _: &Reference<D>, _: &Effector<D>, rest: &Rest, out: &mut [f64]) {
         let s = self.pid.state_holding(rest.force).unwrap_or_default();
         out[0] = s.integral;
         out[1] = s.filter;

@@ -7,82 +7,96 @@
 //! ```
 //!
 //! The tension sum is no longer fixed: the z loop acts through it. Anti-windup by conditional
-//! integration: while the command is clamped to [t_min, t_max], both integrals hold.
+//! integration: while the command is clamped to [t_min, t_max], the integrals hold. In space the
+//! y axis takes the x gains.
 
-use super::{Controller, Measures, Output, Pid, PidState, Plant, Reference, Rest, StepStart};
-use crate::Vector2;
-use crate::model::Effector;
+use super::{Controller, Measures, Output, Pid, PidState, Reference, Rest, StepStart};
+use crate::robot::{Effector, Robot, Tensions, Vector, along_vertical, vertical};
 use crate::scenario::{self, ControllerKind};
 
-/// Two PIDs (x, z) decoupled through W.
+/// One PID per axis (x and, in space, y with the x gains; z with its own), decoupled through W.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PidXz {
-    pub x: Pid,
-    pub z: Pid,
-    pub plant: Plant,
+pub struct PidXz<const D: usize> {
+    pub axes: [Pid; D],
+    pub robot: Robot<D>,
 }
 
-impl PidXz {
-    pub fn new(c: &scenario::Controller, plant: Plant) -> Self {
+impl<const D: usize> PidXz<D> {
+    pub fn new(c: &scenario::Controller, robot: Robot<D>) -> Self {
+        let horizontal = Pid::from(c);
+        let vertical_pid = Pid {
+            p: c.p_z,
+            i: c.i_z,
+            d: c.d_z,
+            filter: c.filter,
+        };
         Self {
-            x: Pid::from(c),
-            z: Pid {
-                p: c.p_z,
-                i: c.i_z,
-                d: c.d_z,
-                filter: c.filter,
-            },
-            plant,
+            axes: std::array::from_fn(|k| {
+                if k == vertical::<D>() {
+                    vertical_pid
+                } else {
+                    horizontal
+                }
+            }),
+            robot,
         }
     }
 
-    fn errors(reference: &Reference, effector: &Effector) -> Vector2<f64> {
+    fn errors(reference: &Reference<D>, effector: &Effector<D>) -> Vector<D> {
         reference.position - effector.position
+    }
+
+    /// The robot's weight M g [N].
+    fn weight(&self) -> f64 {
+        self.robot.effector_mass * self.robot.gravity
     }
 }
 
-/// Loop k's (x: 0, z: 1) PID states in `states`.
 fn state(states: &[f64], k: usize) -> PidState {
     PidState::of(&states[2 * k..])
 }
 
-impl Controller for PidXz {
+impl<const D: usize> Controller<D> for PidXz<D> {
     fn kind(&self) -> ControllerKind {
         ControllerKind::PidXz
     }
     fn state_len(&self) -> usize {
-        4
+        2 * D
     }
     fn measures(&self) -> Measures {
         Measures {
-            z: true,
+            all_axes: true,
             velocity: false,
         }
     }
-    fn output(&self, reference: &Reference, effector: &Effector, states: &[f64]) -> Output {
+    fn output(
+        &self,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
+        states: &[f64],
+    ) -> Output<D> {
         let e = Self::errors(reference, effector);
-        let force = Vector2::new(
-            self.x.force(e.x, state(states, 0)),
-            self.z.force(e.y, state(states, 1)),
-        );
-        let p = &self.plant;
-        let pull = force + Vector2::new(0.0, p.effector_mass * p.gravity);
+        let force = Vector::<D>::from_fn(|k, _| self.axes[k].force(e[k], state(states, k)));
+        let pull = force + along_vertical::<D>(self.weight());
         Output {
-            force: force.x,
-            tensions: super::tensions_for_force(effector.position, p.anchor_distance, pull),
+            wrench: force,
+            tensions: self
+                .robot
+                .tensions_for_force(&effector.position, &pull)
+                .unwrap_or_else(|| Tensions::from_fn(self.robot.cables(), |_| f64::NAN)),
         }
     }
     fn state_rate(
         &self,
-        reference: &Reference,
-        effector: &Effector,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         states: &[f64],
         saturated: bool,
         rate: &mut [f64],
     ) {
         let e = Self::errors(reference, effector);
-        for (k, (pid, e)) in [(self.x, e.x), (self.z, e.y)].into_iter().enumerate() {
-            let r = pid.state_rate(e, state(states, k));
+        for (k, pid) in self.axes.iter().enumerate() {
+            let r = pid.state_rate(e[k], state(states, k));
             rate[2 * k] = if saturated { 0.0 } else { r.integral };
             rate[2 * k + 1] = r.filter;
         }
@@ -90,19 +104,16 @@ impl Controller for PidXz {
     fn trapezoidal_step(
         &self,
         h: f64,
-        start: &StepStart,
-        reference: &Reference,
-        effector: &Effector,
+        start: &StepStart<D>,
+        reference: &Reference<D>,
+        effector: &Effector<D>,
         out: &mut [f64],
     ) {
         let e0 = Self::errors(&start.reference, &start.effector);
         let e1 = Self::errors(reference, effector);
-        for (k, (pid, e0, e1)) in [(self.x, e0.x, e1.x), (self.z, e0.y, e1.y)]
-            .into_iter()
-            .enumerate()
-        {
+        for (k, pid) in self.axes.iter().enumerate() {
             let s0 = state(start.states, k);
-            let s = pid.trapezoidal_step(s0, e0, e1, h);
+            let s = pid.trapezoidal_step(s0, e0[k], e1[k], h);
             out[2 * k] = if start.saturated {
                 s0.integral
             } else {
@@ -111,16 +122,14 @@ impl Controller for PidXz {
             out[2 * k + 1] = s.filter;
         }
     }
-    fn rest_states(&self, _: &Reference, effector: &Effector, rest: &Rest, out: &mut [f64]) {
-        let p = &self.plant;
-        let w = super::structure_matrix(effector.position, p.anchor_distance);
-        let pull = w * Vector2::new(rest.tensions[0], rest.tensions[1]);
-        let force = pull - Vector2::new(0.0, p.effector_mass * p.gravity);
-        for (k, (pid, f)) in [(self.x, force.x), (self.z, force.y)]
-            .into_iter()
-            .enumerate()
-        {
-            let s = pid.state_holding(f).unwrap_or_default();
+    fn rest_states(&self, _: &Reference<D>, effector: &Effector<D>, rest: &Rest, out: &mut [f64]) {
+        let pull = self
+            .robot
+            .structure_matrix(&effector.position)
+            .force(&rest.tensions);
+        let force = pull - along_vertical::<D>(self.weight());
+        for (k, pid) in self.axes.iter().enumerate() {
+            let s = pid.state_holding(force[k]).unwrap_or_default();
             out[2 * k] = s.integral;
             out[2 * k + 1] = s.filter;
         }

@@ -14,7 +14,9 @@
 //! Filtering the error rather than the velocity keeps a perfectly tracked move error-free.
 
 /// The filter's per-axis state (ė_f, ė_f') for both axes: [ė_f,x, ė_f,z, ė_f'_x, ė_f'_z].
-pub const STATES: usize = 4;
+/// Number of states per axis: the filtered error and its rate (layout: every axis's filtered
+/// error, then every axis's rate).
+pub const STATES_PER_AXIS: usize = 2;
 
 /// The low-pass of corner ω_f [rad/s]; ω_f = ∞ passes the velocity error unfiltered.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,13 +36,14 @@ impl VelocityFilter {
         if self.is_on() { states[k] } else { error }
     }
 
-    /// d/dt of the states for the raw velocity errors `error` (x, z).
-    pub fn rate(&self, states: &[f64], error: [f64; 2], rate: &mut [f64]) {
+    /// d/dt of the states for the raw velocity errors `error`, one per axis.
+    pub fn rate(&self, states: &[f64], error: &[f64], rate: &mut [f64]) {
         let w = self.omega;
-        for k in 0..2 {
-            let (v, dv) = (states[k], states[2 + k]);
+        let n = error.len();
+        for k in 0..n {
+            let (v, dv) = (states[k], states[n + k]);
             rate[k] = dv;
-            rate[2 + k] = if self.is_on() {
+            rate[n + k] = if self.is_on() {
                 w * w * (error[k] - v) - 2.0 * w * dv
             } else {
                 0.0
@@ -54,18 +57,19 @@ impl VelocityFilter {
     pub fn trapezoidal_step(
         &self,
         start: &[f64],
-        e_start: [f64; 2],
-        e_end: [f64; 2],
+        e_start: &[f64],
+        e_end: &[f64],
         h: f64,
         out: &mut [f64],
     ) {
+        let n = e_start.len();
         if !self.is_on() {
-            out[..STATES].fill(0.0);
+            out[..STATES_PER_AXIS * n].fill(0.0);
             return;
         }
         let (w, k) = (self.omega, 0.5 * h);
-        for axis in 0..2 {
-            let (v0, d0) = (start[axis], start[2 + axis]);
+        for axis in 0..n {
+            let (v0, d0) = (start[axis], start[n + axis]);
             let u = e_start[axis] + e_end[axis];
             // Right-hand side (I + kA) s₀ + k B u.
             let r0 = v0 + k * d0;
@@ -74,7 +78,7 @@ impl VelocityFilter {
             let (a, b, c, d) = (1.0, -k, k * w * w, 1.0 + 2.0 * k * w);
             let det = a * d - b * c;
             out[axis] = (d * r0 - b * r1) / det;
-            out[2 + axis] = (a * r1 - c * r0) / det;
+            out[n + axis] = (a * r1 - c * r0) / det;
         }
     }
 }

@@ -356,6 +356,18 @@ impl Scenario {
         Self::default()
     }
 
+    /// The planar robot of the `[robot]` section: pulleys A1 = (0, 0) and A2 = (d, 0), z up
+    /// (validated with the scenario).
+    pub fn robot(&self) -> crate::robot::Robot<2> {
+        let r = &self.robot;
+        let anchors = [
+            crate::robot::Vector::<2>::new(0.0, 0.0),
+            crate::robot::Vector::<2>::new(r.anchor_distance, 0.0),
+        ];
+        crate::robot::Robot::new(&anchors, r.effector_mass, r.gravity)
+            .expect("a validated scenario's robot")
+    }
+
     /// Parses and validates a scenario from TOML text.
     pub fn from_toml_str(text: &str) -> Result<Self, ScenarioError> {
         let scenario: Scenario = toml::from_str(text)

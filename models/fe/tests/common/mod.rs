@@ -8,7 +8,8 @@
 
 use cdpr_core::Vector2;
 use cdpr_core::channel::Channel;
-use cdpr_core::model::CableModel;
+use cdpr_core::model::{CableModel, SplitRule};
+use cdpr_core::robot::Tensions;
 use cdpr_core::scenario::Scenario;
 use cdpr_fe::{E_OUT, Fe, FeMass, FeStored, Params};
 
@@ -45,7 +46,7 @@ impl Lcg {
 /// A random admissible state near the equilibrium at `x`: positions disturbed by up to `dq` m
 /// (border included), velocities up to `v` m/s (l', ρ' up to v/2).
 pub fn random_state(m: &mut Fe, x: f64, seed: u64, dq: f64, v: f64) -> Vec<f64> {
-    let eq = m.equilibrium(x, 200.0).unwrap();
+    let eq = m.equilibrium(&SplitRule::new(x, 200.0)).unwrap();
     let mut y = eq.state;
     let np = m.positions_len();
     let mut rng = Lcg(seed);
@@ -190,7 +191,7 @@ pub fn wobbling_run(
     use cdpr_core::runner::{RunOptions, simulate_from};
     use cdpr_numerics::Dopri5Options;
     y.extend_from_slice(&[0.0; 4]);
-    let mut sys = ClosedLoop::new(m, scenario);
+    let mut sys = ClosedLoop::new(m, scenario).unwrap();
     sys.actuation = wobbling_tensions();
     let dopri = Dopri5Options {
         rtol,
@@ -215,9 +216,9 @@ pub fn column_max_abs(run: &cdpr_core::runner::Run, channel: Channel) -> f64 {
 pub fn wobbling_tensions() -> cdpr_core::closed_loop::Actuation {
     let pi = std::f64::consts::PI;
     cdpr_core::closed_loop::Actuation::Prescribed(Box::new(move |t| {
-        [
+        Tensions::pair([
             100.0 + 10.0 * (6.0 * pi * t).sin(),
             100.0 + 10.0 * (6.0 * pi * t + 0.5).sin() + 3.0 * (14.0 * pi * t).sin(),
-        ]
+        ])
     }))
 }
