@@ -79,7 +79,7 @@ impl ControlMetrics {
 
     /// Computes the metrics of a run's channels.
     pub fn from_columns(c: &Columns, context: &ControlContext) -> Self {
-        let (t, z, err, t1, t2) = (c.t, c.z, c.err, c.t1, c.t2);
+        let (t, z, err) = (c.t, c.z, c.err);
         let z0 = z.first().copied().unwrap_or(f64::NAN);
         let half = 0.5 * context.sample_period;
         let transition = t.partition_point(|&v| v < context.move_start - half)
@@ -98,12 +98,10 @@ impl ControlMetrics {
         let t_end = t.last().copied().unwrap_or(0.0);
         let last = t.partition_point(|&v| v < t_end - Z_MEAN_WINDOW - half);
         let z_end = mean(&z[last..]);
-        let tensions = t1.iter().chain(t2);
+        let tensions = c.tensions.iter().flat_map(|v| v.iter());
         let at_limit = |v: f64| v <= context.limits.t_min || v >= context.limits.t_max;
-        let saturated: Vec<bool> = t1
-            .iter()
-            .zip(t2)
-            .map(|(&a, &b)| at_limit(a) || at_limit(b))
+        let saturated: Vec<bool> = (0..t.len())
+            .map(|i| c.tensions.iter().any(|v| at_limit(v[i])))
             .collect();
         Self {
             controller: context.controller.to_owned(),

@@ -12,6 +12,7 @@
 use crate::control_metrics::{ControlContext, ControlMetrics};
 use crate::spectrum::{NoPeak, Peak, RefinedSpectrum, Spectrum, Window};
 use cdpr_core::channel::Channel;
+use cdpr_core::robot::CableId;
 use cdpr_core::runner::Run;
 use cdpr_core::trajectory::Step5;
 
@@ -78,7 +79,7 @@ pub struct Metrics {
     /// The windows the metrics below are measured over.
     pub windows: Windows,
     /// Each metric that is NaN because the run does not reach or fill its window, and why.
-    pub unavailable: std::collections::BTreeMap<&'static str, String>,
+    pub unavailable: std::collections::BTreeMap<String, String>,
     /// Minimum of the commanded T1 [N] and when [s].
     pub t1_min: f64,
     pub t1_min_time: f64,
@@ -95,6 +96,10 @@ pub struct Metrics {
     /// one [N].
     pub t1_mean_last_1s: f64,
     pub t2_mean_last_1s: f64,
+    /// The same six keys for cables 3…m (`t3_min`, `t3_min_time`, …, `t3_mean_last_1s`, …):
+    /// present only for a robot of more than two cables.
+    #[serde(flatten)]
+    pub further_cables: FurtherCables,
     /// max |x_ref − x| over the `transition` window [m].
     pub err_max_transition: f64,
     /// max |x_ref − x| over the `settled` window [m].
@@ -240,6 +245,8 @@ pub struct Columns<'a> {
     pub err: &'a [f64],
     pub t1: &'a [f64],
     pub t2: &'a [f64],
+    /// Every cable's commanded tension, cable 1 first (`t1`, `t2` are the first two).
+    pub tensions: Vec<&'a [f64]>,
     pub e_residual: &'a [f64],
 }
 
@@ -255,6 +262,9 @@ impl<'a> Columns<'a> {
             err: col(Channel::Error),
             t1: col(Channel::T1),
             t2: col(Channel::T2),
+            tensions: (0..)
+                .map_while(|i| s.channel(Channel::Tension(CableId(i))))
+                .collect(),
             e_residual: col(Channel::EResidual),
         }
     }
@@ -430,6 +440,11 @@ impl Metrics {
             .map(|p| [p.omega, db(p)])
             .collect();
 
+        let further_cables = c.tensions[c.tensions.len().min(2)..]
+            .iter()
+            .map(|v| CableTensions::of(t, v, last.clone()))
+            .collect();
+        let further_cables = FurtherCables(further_cables);
         let mut metrics = Self {
             model: run.model.to_owned(),
             windows,
@@ -446,6 +461,7 @@ impl Metrics {
             t2_final: t2.last().copied().unwrap_or(f64::NAN),
             t1_mean_last_1s: mean(&t1[last.clone()]),
             t2_mean_last_1s: mean(&t2[last]),
+            further_cables,
             err_max_transition: max_abs(&err[transition]),
             err_max_settled: max_abs(&err[settled.clone()]),
             err_max_settled_strict: max_abs(&err[strict]),
@@ -535,6 +551,11 @@ impl Metrics {
             for key in ["t1_mean_last_1s", "t2_mean_last_1s"] {
                 unavailable.push((key, why.clone()));
             }
+            for (i, cable) in self.further_cables.0.iter_mut().enumerate() {
+                cable.mean_last_1s = f64::NAN;
+                let key = format!("t{}_mean_last_1s", i + 3);
+                self.unavailable.entry(key).or_insert_with(|| why.clone());
+            }
         }
         let spectral = [
             ("z_peak_rad_s", "z", "refined"),
@@ -592,7 +613,7 @@ impl Metrics {
             if !self.set_nan(key) {
                 continue;
             }
-            self.unavailable.entry(key).or_insert(why);
+            self.unavailable.entry(key.to_owned()).or_insert(why);
         }
         if self.z_fft_record_rad_s.is_nan() {
             self.z_fft_record_bin = 0;
@@ -624,5 +645,99 @@ impl Metrics {
         };
         *slot = f64::NAN;
         true
+    }
+}
+
+/// One cable's commanded-tension metrics (the `tk_*` keys of cable k ≥ 3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CableTensions {
+    /// Minimum [N] and when [s].
+    pub min: f64,
+    pub min_time: f64,
+    /// Maximum [N] and when [s].
+    pub max: f64,
+    pub max_time: f64,
+    /// At t_final [N].
+    pub final_value: f64,
+    /// Mean over the `last` window [N].
+    pub mean_last_1s: f64,
+}
+
+impl CableTensions {
+    fn of(t: &[f64], v: &[f64], last: std::ops::Range<usize>) -> Self {
+        let (min_time, min) = extreme(t, v, |a, b| a < b);
+        let (max_time, max) = extreme(t, v, |a, b| a > b);
+        Self {
+            min,
+            min_time,
+            max,
+            max_time,
+            final_value: v.last().copied().unwrap_or(f64::NAN),
+            mean_last_1s: mean(&v[last]),
+        }
+    }
+}
+
+/// The tension metrics of cables 3…m, cable 3 first; written as the keys `t3_min` … (NaN as
+/// null), none for the planar robot.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FurtherCables(pub Vec<CableTensions>);
+
+impl serde::Serialize for FurtherCables {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(Some(6 * self.0.len()))?;
+        for (i, c) in self.0.iter().enumerate() {
+            let k = i + 3;
+            for (name, value) in [
+                ("min", c.min),
+                ("min_time", c.min_time),
+                ("max", c.max),
+                ("max_time", c.max_time),
+                ("final", c.final_value),
+                ("mean_last_1s", c.mean_last_1s),
+            ] {
+                let value = value.is_finite().then_some(value);
+                map.serialize_entry(&format!("t{k}_{name}"), &value)?;
+            }
+        }
+        map.end()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Cable k's six metrics of a known series: extremes and their times, the last sample, the
+    /// mean over the `last` range.
+    #[test]
+    fn a_further_cable_is_measured_like_the_first_two() {
+        let t = [0.0, 0.1, 0.2, 0.3, 0.4];
+        let v = [5.0, 2.0, 9.0, 4.0, 6.0];
+        let c = CableTensions::of(&t, &v, 3..5);
+        assert_eq!((c.min, c.min_time, c.max, c.max_time), (2.0, 0.1, 9.0, 0.2));
+        assert_eq!((c.final_value, c.mean_last_1s), (6.0, 5.0));
+    }
+
+    /// Cables 3 and 4 become the keys t3_* then t4_*, NaN as null; none for the plane.
+    #[test]
+    fn further_cables_are_numbered_keys() {
+        let c = CableTensions {
+            min: 1.0,
+            min_time: 2.0,
+            max: 3.0,
+            max_time: 4.0,
+            final_value: 5.0,
+            mean_last_1s: f64::NAN,
+        };
+        let json = serde_json::to_value(FurtherCables(vec![c, c])).unwrap();
+        let keys: Vec<&String> = json.as_object().unwrap().keys().collect();
+        assert_eq!(keys.len(), 12);
+        assert_eq!(json["t3_min"], 1.0);
+        assert_eq!(json["t4_final"], 5.0);
+        assert!(json["t4_mean_last_1s"].is_null());
+        let plane = serde_json::to_value(FurtherCables::default()).unwrap();
+        assert!(plane.as_object().unwrap().is_empty());
     }
 }

@@ -40,7 +40,7 @@ fn windows_follow_the_move() {
     assert!(m.err_max_transition > 5e-3, "{}", m.err_max_transition);
     // Null with reasons, not numbers: the record's plain spectrum is the step of the move at 2 s
     // leaking into its lowest bin (no peak), and z rings by 1.4 mm: it never settles to 10 µm.
-    let keys: Vec<&str> = m.unavailable.keys().copied().collect();
+    let keys: Vec<&str> = m.unavailable.keys().map(String::as_str).collect();
     assert_eq!(
         keys,
         ["z_fft_record_rad_s", "z_settle_s"],

@@ -3,8 +3,8 @@
 //! same unstrained arc length s_k = k L0/N.
 
 use cdpr_bench::core::Vector2;
-use cdpr_bench::fe::chain::FixedCable;
 use cdpr_bench::fe::element::Material;
+use cdpr_bench::fe::fixed_cable::FixedCable;
 use cdpr_verify::irvine::Catenary;
 
 const MU: f64 = 0.013816;

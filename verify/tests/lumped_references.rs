@@ -6,7 +6,7 @@ use cdpr_bench::ModelKind;
 use cdpr_bench::core::Vector2;
 use cdpr_bench::core::channel::Channel;
 use cdpr_bench::core::scenario::Scenario;
-use cdpr_bench::lumped::chain::Chain;
+use cdpr_bench::lumped::fixed_cable::FixedCable as LumpedCable;
 use cdpr_bench::{ModelConfig, simulate};
 use cdpr_verify::irvine::Catenary;
 use faer::{Mat, Side};
@@ -74,7 +74,7 @@ fn irvine_solver_reproduces_the_tabulated_tensions() {
 /// length s_k = k L0/N [m].
 fn chain_error(end: [f64; 2], length: f64, ea: f64, n: usize) -> f64 {
     let exact = Catenary::through(end, length, MU * G, ea).unwrap();
-    let chain = Chain::new(
+    let chain = LumpedCable::new(
         [Vector2::new(0.0, 0.0), Vector2::new(end[0], end[1])],
         length,
         n,
@@ -130,7 +130,7 @@ proptest! {
     ) {
         let ea = 179520.0;
         let length = span / (1.0 + tension / ea);
-        let chain = Chain::new([Vector2::new(0.0, 0.0), Vector2::new(span, 0.0)], length, n, ea, MU, 0.0);
+        let chain = LumpedCable::new([Vector2::new(0.0, 0.0), Vector2::new(span, 0.0)], length, n, ea, MU, 0.0);
         let dim = 2 * (n - 1);
         let straight: Vec<f64> = (1..n).flat_map(|k| [k as f64 * span / n as f64, 0.0]).collect();
         let mut k = Mat::<f64>::zeros(dim, dim);

@@ -18,7 +18,7 @@ use cdpr_bench::core::trajectory::Step5;
 use cdpr_bench::elastic::Elastic;
 use cdpr_bench::lumped::Lumped;
 use cdpr_bench::lumped::Params;
-use cdpr_bench::lumped::chain::Chain;
+use cdpr_bench::lumped::fixed_cable::FixedCable as LumpedCable;
 use cdpr_bench::numerics::{Dopri5Options, OdeSystem};
 use cdpr_bench::numerics::{differences, eigen};
 use cdpr_bench::{ModelConfig, analyse, linearise};
@@ -111,7 +111,7 @@ fn elastic_vertical_mode_at_the_symmetric_position() {
 }
 
 /// The fixed-end lumped chain as a first-order system y = (q, q'), q'' = F(q)/m.
-struct ChainOde(Chain);
+struct ChainOde(LumpedCable);
 
 impl OdeSystem for ChainOde {
     fn dimension(&self) -> usize {
@@ -142,7 +142,7 @@ proptest! {
     ) {
         let (ea, mu) = (179_520.0, 0.013816);
         let chord = length * (1.0 + tension / ea);
-        let chain = Chain::new(
+        let chain = LumpedCable::new(
             [Vector2::new(0.0, 0.0), Vector2::new(chord, 0.0)],
             length,
             elements,

@@ -12,9 +12,9 @@
 //! - a pendulum: a 1 kg mass on the cable released from 0.3 rad, MoorDyn against the lumped chain.
 
 use cdpr_bench::core::Vector2;
-use cdpr_bench::fe::chain::FixedCable;
 use cdpr_bench::fe::element::Material;
-use cdpr_bench::lumped::chain::Chain;
+use cdpr_bench::fe::fixed_cable::FixedCable;
+use cdpr_bench::lumped::fixed_cable::FixedCable as LumpedCable;
 use cdpr_bench::lumped::spring_tension;
 use cdpr_bench::numerics::{Dopri5, Dopri5Options, OdeSystem};
 use cdpr_verify::irvine::Catenary;
@@ -91,18 +91,18 @@ fn rows(nodes: &[Vector2<f64>], velocities: &[Vector2<f64>]) -> Value {
     )
 }
 
-/// The lumped chain's dynamics: interior nodes of mass μ l0 under [`Chain::forces`], and end B
+/// The lumped chain's dynamics: interior nodes of mass μ l0 under [`LumpedCable::forces`], and end B
 /// either fixed or a free point of mass M + μ l0/2 carrying its weight and the last spring.
 /// State: interior positions (x, z interleaved), then end B, then the same velocities.
 struct ChainDynamics {
-    chain: Chain,
+    chain: LumpedCable,
     /// M + μ l0 / 2 of a free end B [kg]; `None`: B fixed.
     end_mass: Option<f64>,
     forces: Vec<f64>,
 }
 
 impl ChainDynamics {
-    fn new(chain: Chain, end_mass: Option<f64>) -> Self {
+    fn new(chain: LumpedCable, end_mass: Option<f64>) -> Self {
         let n = chain.elements;
         let end_mass = end_mass.map(|m| m + 0.5 * chain.node_mass);
         Self {
@@ -229,7 +229,7 @@ fn catenaries_match_irvine_and_moordyn_holds_the_lumped_and_fe_equilibria() {
             "{name}: MoorDyn's catenary is {worst:e} m from Irvine's"
         );
 
-        let lumped = Chain::new(ends, length, n, EA, MU, G)
+        let lumped = LumpedCable::new(ends, length, n, EA, MU, G)
             .equilibrium()
             .unwrap();
         let fe = FixedCable {
@@ -255,7 +255,7 @@ fn catenaries_match_irvine_and_moordyn_holds_the_lumped_and_fe_equilibria() {
         );
 
         let drift = |mu: f64| {
-            let nodes = Chain::new(ends, length, n, EA, mu, G)
+            let nodes = LumpedCable::new(ends, length, n, EA, mu, G)
                 .equilibrium()
                 .unwrap();
             let interior = &nodes[1..n];
@@ -343,7 +343,7 @@ fn taut_cable_modes_match_moordyn_and_the_discrete_string() {
             .iter()
             .map(|sample| displacement(points(sample)[mid]))
             .collect();
-        let mut sys = ChainDynamics::new(Chain::new(ends, length, n, EA, MU, 0.0), None);
+        let mut sys = ChainDynamics::new(LumpedCable::new(ends, length, n, EA, MU, 0.0), None);
         let mut y0 = vec![0.0; sys.dimension()];
         for (k, p) in interior.iter().enumerate() {
             y0[2 * k] = p.x;
@@ -401,7 +401,7 @@ fn pendulum_swing_matches_moordyn() {
         .map(|sample| points(sample)[n])
         .collect();
     let path = |mu: f64| -> Vec<Vector2<f64>> {
-        let chain = Chain::new([Vector2::zeros(), end], length, n, EA, mu, G);
+        let chain = LumpedCable::new([Vector2::zeros(), end], length, n, EA, mu, G);
         let mut sys = ChainDynamics::new(chain, Some(mass));
         let mut y0 = vec![0.0; sys.dimension()];
         for (k, p) in interior.iter().chain([&end]).enumerate() {

@@ -11,6 +11,7 @@
 pub mod channel;
 pub mod closed_loop;
 pub mod controller;
+pub mod fixed_end;
 pub mod geometry;
 pub mod modal_layout;
 pub mod model;

@@ -22,8 +22,8 @@
 //! path's residual M q'' − F sums each element's rows without assembling
 //! ([`element::residual_at_chord`], the span elements in lanes).
 
-pub mod chain;
 pub mod element;
+pub mod fixed_cable;
 mod implicit;
 mod lanes;
 mod modal;

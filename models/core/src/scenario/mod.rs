@@ -7,46 +7,15 @@
 use serde::Deserialize;
 
 mod controller;
+mod error;
+mod validate;
 pub use controller::{Controller, ControllerKind};
+pub use error::{
+    MAX_ELEMENTS, ScenarioError, count_in_range, finite, non_negative, out_of_range, positive,
+};
 
 use crate::shaper::{Impulses, ShaperKind};
-use std::fmt;
 use std::path::Path;
-
-/// Why a scenario was refused.
-#[derive(Debug, thiserror::Error)]
-pub enum ScenarioError {
-    /// The OS error is part of the message, not a `source`: printed with its chain it would
-    /// otherwise appear twice.
-    #[error("cannot read scenario file {path}: {error}")]
-    Io { path: String, error: std::io::Error },
-    /// Malformed TOML, an unknown key or a value of the wrong type (the message names the key).
-    #[error("invalid scenario file: {0}")]
-    Syntax(String),
-    /// A value outside its allowed range.
-    #[error("scenario key `{key}` = {value} is out of range: allowed {allowed}")]
-    OutOfRange {
-        key: &'static str,
-        value: String,
-        allowed: String,
-    },
-    /// Values each in range that together cannot start a run (no start equilibrium, no
-    /// controller design, no mode for an "auto" shaper), found before the run.
-    #[error("scenario keys {keys}: {why}")]
-    Infeasible { keys: String, why: String },
-}
-
-pub fn out_of_range(
-    key: &'static str,
-    value: impl fmt::Display,
-    allowed: impl Into<String>,
-) -> ScenarioError {
-    ScenarioError::OutOfRange {
-        key,
-        value: value.to_string(),
-        allowed: allowed.into(),
-    }
-}
 
 /// Robot geometry and effector (MODELS.md §1).
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
@@ -385,142 +354,6 @@ impl Scenario {
         Self::from_toml_str(&text)
     }
 
-    /// Checks every value against its physical range; the first violation is returned.
-    pub fn validate(&self) -> Result<(), ScenarioError> {
-        let r = &self.robot;
-        positive("robot.anchor_distance", r.anchor_distance)?;
-        positive("robot.effector_mass", r.effector_mass)?;
-        // The effector hangs below the pulleys on taut cables: without gravity it has no rest
-        // below them (the run left the workspace at t = 0).
-        positive("robot.gravity", r.gravity)?;
-
-        let c = &self.cable;
-        positive("cable.youngs_modulus", c.youngs_modulus)?;
-        positive("cable.area", c.area)?;
-        positive("cable.density", c.density)?;
-        positive("cable.modelled_length", c.modelled_length)?;
-        non_negative("cable.axial_damping", c.axial_damping)?;
-
-        self.controller.validate(r)?;
-
-        let t = &self.trajectory;
-        let d = r.anchor_distance;
-        for (key, x) in [("trajectory.x1", t.x1), ("trajectory.x2", t.x2)] {
-            finite(key, x)?;
-            if !(x > 0.0 && x < d) {
-                return Err(out_of_range(
-                    key,
-                    x,
-                    format!("(0, anchor_distance = {d}) m: the workspace between the pulleys"),
-                ));
-            }
-        }
-        finite("trajectory.t1", t.t1)?;
-        if t.t1 < 0.0 {
-            return Err(out_of_range("trajectory.t1", t.t1, "≥ 0 s"));
-        }
-        finite("trajectory.t2", t.t2)?;
-        if t.t2 <= t.t1 {
-            return Err(out_of_range(
-                "trajectory.t2",
-                t.t2,
-                format!("> t1 = {} s", t.t1),
-            ));
-        }
-
-        let kind = self.controller.kind;
-        match (kind.acts_on_z(), t.z_ref) {
-            (false, Some(ZRef::Hold)) => {
-                return Err(out_of_range(
-                    "trajectory.z_ref",
-                    "\"hold\"",
-                    format!(
-                        "\"free\" with controller.kind = \"{}\": it does not act on z",
-                        kind.name()
-                    ),
-                ));
-            }
-            (true, Some(ZRef::Free)) => {
-                return Err(out_of_range(
-                    "trajectory.z_ref",
-                    "\"free\"",
-                    format!(
-                        "\"hold\" with controller.kind = \"{}\": it regulates z",
-                        kind.name()
-                    ),
-                ));
-            }
-            _ => {}
-        }
-
-        // The shaper's design values, where given (the zeros of "auto" only to check the others).
-        if t.shaper != ShaperKind::None {
-            Impulses::design(
-                t.shaper,
-                t.shaper_frequency.value().unwrap_or(1.0),
-                t.shaper_damping.value().unwrap_or(0.0),
-                t.shaper_vtol,
-            )?;
-        }
-
-        let s = &self.simulation;
-        positive("simulation.t_final", s.t_final)?;
-        finite("simulation.rtol", s.rtol)?;
-        if !(s.rtol >= 1e-14 && s.rtol <= 0.1) {
-            return Err(out_of_range("simulation.rtol", s.rtol, "[1e-14, 0.1]"));
-        }
-        positive("simulation.atol", s.atol)?;
-        positive("simulation.sample_period", s.sample_period)?;
-        if s.sample_period > s.t_final {
-            return Err(out_of_range(
-                "simulation.sample_period",
-                s.sample_period,
-                format!("(0, t_final = {}] s", s.t_final),
-            ));
-        }
-        if s.t_final / s.sample_period > MAX_SAMPLES {
-            return Err(out_of_range(
-                "simulation.sample_period",
-                s.sample_period,
-                format!(
-                    "≥ t_final / {MAX_SAMPLES:e} = {} s",
-                    s.t_final / MAX_SAMPLES
-                ),
-            ));
-        }
-        finite("simulation.dopri_beta", s.dopri_beta)?;
-        if !(0.0..=0.2).contains(&s.dopri_beta) {
-            return Err(out_of_range(
-                "simulation.dopri_beta",
-                s.dopri_beta,
-                "[0, 0.2]",
-            ));
-        }
-        positive("simulation.step", s.step)?;
-        if s.integrator == IntegratorKind::Implicit {
-            let largest = self.largest_implicit_step();
-            if s.step > largest {
-                return Err(out_of_range(
-                    "simulation.step",
-                    s.step,
-                    format!(
-                        "≤ {largest:e} s for this scenario: the fixed step must resolve the move \
-                         (at least {STEPS_PER_MOVE} steps over t2 − t1 = {} s) and the PID's \
-                         derivative filter (h ≤ 1/filter = {:e} s)",
-                        t.t2 - t.t1,
-                        1.0 / self.controller.filter
-                    ),
-                ));
-            }
-        }
-        finite("simulation.rho_inf", s.rho_inf)?;
-        if !(0.0..=1.0).contains(&s.rho_inf) {
-            return Err(out_of_range("simulation.rho_inf", s.rho_inf, "[0, 1]"));
-        }
-
-        Ok(())
-    }
-
     /// The largest fixed step [s] the implicit path accepts: generalised-α is unconditionally
     /// stable, so nothing stops a step that skips over the physics but this rule. The step must
     /// resolve the move ([`STEPS_PER_MOVE`] steps over [t1, t2]) and the controller's fastest
@@ -558,50 +391,6 @@ impl Scenario {
         let chord = reach.hypot(sag);
         let stretch = 1.0 + self.controller.tension_sum / self.cable.axial_stiffness();
         (1.05 * stretch * chord, chord)
-    }
-}
-
-/// Largest element count a model accepts (`model.elements`; memory and run time grow like N).
-pub const MAX_ELEMENTS: usize = 100_000;
-
-/// An element count `key` = `value` in [1, [`MAX_ELEMENTS`]], or `default` when absent.
-pub fn count_in_range(
-    key: &'static str,
-    value: Option<i64>,
-    default: usize,
-) -> Result<usize, ScenarioError> {
-    match value {
-        None => Ok(default),
-        Some(n) if (1..=MAX_ELEMENTS as i64).contains(&n) => Ok(n as usize),
-        Some(n) => Err(out_of_range(
-            key,
-            n,
-            format!("an integer in [1, {MAX_ELEMENTS}]"),
-        )),
-    }
-}
-
-pub fn finite(key: &'static str, v: f64) -> Result<(), ScenarioError> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(out_of_range(key, v, "a finite number"))
-    }
-}
-
-pub fn positive(key: &'static str, v: f64) -> Result<(), ScenarioError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(out_of_range(key, v, "finite and > 0"))
-    }
-}
-
-pub fn non_negative(key: &'static str, v: f64) -> Result<(), ScenarioError> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(())
-    } else {
-        Err(out_of_range(key, v, "finite and ≥ 0"))
     }
 }
 

@@ -2,98 +2,26 @@
 //! scenario's integrator, samples it on the dense output, locates and applies the model's events,
 //! and stops with a reason ([`RunError`]) while keeping what it sampled ([`RunFailure`]).
 
+mod error;
+mod events;
+mod sampler;
+
+pub use error::{RunError, RunFailure};
+pub use events::EVENT_TIME_TOL;
+use events::{EventMonitor, check_slack};
+use sampler::Sampler;
+
 use crate::channel::Channel;
-use crate::closed_loop::{ClosedLoop, LoopError};
-use crate::controller::{ControlError, Controller};
-use crate::model::{CableModel, Equilibrium, ModelError, ModelEvent};
-use crate::robot::{CableId, Tensions};
+use crate::closed_loop::ClosedLoop;
+use crate::controller::Controller;
+use crate::model::{CableModel, Equilibrium, ModelEvent};
 use crate::scenario::{ImplicitMethod, IntegratorKind, Scenario};
 use crate::series::{SeriesBuffer, TimeSeries};
 use cdpr_numerics::{
-    Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions, IntegratorError, SolverStats,
-    Stepper,
+    Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions, SolverStats, Stepper,
 };
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
-
-/// Why a run stopped early.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum RunError {
-    #[error(transparent)]
-    Model(#[from] ModelError),
-    /// The controller could not be designed at the run's start.
-    #[error(transparent)]
-    Control(#[from] ControlError),
-    /// The loop could not be assembled (e.g. a controller with more states than it holds).
-    #[error("{0}")]
-    Loop(String),
-    /// The integrator's error is part of the message (not a `source`, which a chain would print
-    /// twice).
-    #[error("integrator failed at t = {t} s: {error}")]
-    Integrator { t: f64, error: IntegratorError },
-    /// The effector left the workspace (below the highest anchor and, seen from above, inside
-    /// the anchors' hull; the plane: 0 < x < d, z < 0): a run gone unstable, its numbers past
-    /// here describe no robot.
-    #[error(
-        "the effector left the workspace at t = {t} s: {}, allowed below the highest anchor and between the anchors",
-        coordinates(position)
-    )]
-    Workspace {
-        t: f64,
-        /// The effector's coordinates [m], per axis, the vertical last.
-        position: Vec<f64>,
-    },
-    /// The shaper's design is still "auto": the modal analysis must resolve it first.
-    #[error(
-        "trajectory.shaper_frequency / shaper_damping = \"auto\" are not resolved: the registry's \
-         simulate designs the shaper from the modal analysis before a run"
-    )]
-    UnresolvedShaper,
-    /// A commanded tension ≤ 0 (MODELS.md §2): a cable cannot push.
-    #[error("cable {cable} went slack at t = {t} s: commanded tension {tension} N ≤ 0")]
-    SlackCable {
-        t: f64,
-        cable: CableId,
-        tension: f64,
-    },
-    /// Stopped from outside (an interrupt) after the step that reached `t`.
-    #[error("interrupted at t = {t} s")]
-    Interrupted { t: f64 },
-    /// The scenario asks for an integrator the model does not support.
-    #[error(
-        "simulation.integrator = \"{integrator}\" is not available for the {model} model: {why}"
-    )]
-    Unsupported {
-        integrator: &'static str,
-        model: &'static str,
-        why: &'static str,
-    },
-}
-
-/// "x = …, z = … m" (or x, y, z in space) for a message.
-fn coordinates(position: &[f64]) -> String {
-    let names: &[&str] = if position.len() == 3 {
-        &["x", "y", "z"]
-    } else {
-        &["x", "z"]
-    };
-    let parts: Vec<String> = position
-        .iter()
-        .zip(names)
-        .map(|(value, name)| format!("{name} = {value}"))
-        .collect();
-    format!("{} m", parts.join(", "))
-}
-
-impl From<LoopError> for RunError {
-    fn from(e: LoopError) -> Self {
-        match e {
-            LoopError::Model(e) => RunError::Model(e),
-            LoopError::Control(e) => RunError::Control(e),
-            e @ LoopError::ControllerStates { .. } => RunError::Loop(e.to_string()),
-        }
-    }
-}
 
 /// Output of a run: sampled channels, counters, the initial equilibrium, the state at the end.
 #[derive(Clone)]
@@ -127,34 +55,6 @@ impl std::fmt::Debug for Run {
             .field("events", &self.events.len())
             .field("wall_s", &self.wall_s)
             .finish_non_exhaustive()
-    }
-}
-
-/// A failed run: the reason and everything sampled before it.
-#[derive(Debug, Clone)]
-pub struct RunFailure {
-    pub error: RunError,
-    pub partial: Option<Run>,
-}
-
-impl std::fmt::Display for RunFailure {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}", self.error)?;
-        if let Some(run) = &self.partial {
-            write!(
-                f,
-                " (output kept up to t = {} s, {} samples)",
-                run.t_reached,
-                run.series.len()
-            )?;
-        }
-        Ok(())
-    }
-}
-
-impl std::error::Error for RunFailure {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        Some(&self.error)
     }
 }
 
@@ -493,176 +393,4 @@ fn integrate<M: CableModel<D>, const D: usize>(
         monitor.accept(sys, &y);
     }
     Ok(())
-}
-
-/// Watches the model's event functions between accepted steps and locates sign changes on the
-/// dense output by bisection to [`EVENT_TIME_TOL`] (MODELS.md §4).
-struct EventMonitor {
-    /// g at the start of the current step.
-    before: Vec<f64>,
-    after: Vec<f64>,
-    probe: Vec<f64>,
-    y: Vec<f64>,
-}
-
-/// Width of the bracket a located event time lies in [s].
-pub const EVENT_TIME_TOL: f64 = 1e-12;
-
-impl EventMonitor {
-    fn new<M: CableModel<D>, const D: usize>(sys: &ClosedLoop<M, D>, y: &[f64]) -> Self {
-        let k = sys.model.event_count();
-        let mut monitor = Self {
-            before: vec![0.0; k],
-            after: vec![0.0; k],
-            probe: vec![0.0; k],
-            y: vec![0.0; if k > 0 { y.len() } else { 0 }],
-        };
-        monitor.accept(sys, y);
-        monitor
-    }
-
-    /// Takes `y` as the start of the next step.
-    fn accept<M: CableModel<D>, const D: usize>(&mut self, sys: &ClosedLoop<M, D>, y: &[f64]) {
-        if !self.before.is_empty() {
-            sys.model
-                .event_functions(&y[..sys.model_len()], &mut self.before);
-        }
-    }
-
-    /// The earliest event function that fell from > 0 to ≤ 0 over the last accepted step, with
-    /// the first time at which it is ≤ 0 (to within [`EVENT_TIME_TOL`]).
-    fn earliest_crossing<M: CableModel<D>, const D: usize>(
-        &mut self,
-        sys: &ClosedLoop<M, D>,
-        stepper: &dyn Stepper<ClosedLoop<M, D>>,
-    ) -> Option<(usize, f64)> {
-        if self.before.is_empty() {
-            return None;
-        }
-        let n = sys.model_len();
-        sys.model
-            .event_functions(&stepper.state()[..n], &mut self.after);
-        let mut earliest: Option<(usize, f64)> = None;
-        for k in 0..self.before.len() {
-            if !(self.before[k] > 0.0 && self.after[k] <= 0.0) {
-                continue;
-            }
-            let (mut a, mut b) = (stepper.previous_time(), stepper.time());
-            while b - a > EVENT_TIME_TOL {
-                let mid = 0.5 * (a + b);
-                if mid <= a || mid >= b {
-                    break;
-                }
-                stepper.dense_output(mid, &mut self.y);
-                sys.model.event_functions(&self.y[..n], &mut self.probe);
-                if self.probe[k] > 0.0 {
-                    a = mid;
-                } else {
-                    b = mid;
-                }
-            }
-            if earliest.is_none_or(|(_, t)| b < t) {
-                earliest = Some((k, b));
-            }
-        }
-        earliest
-    }
-}
-
-/// A commanded tension ≤ 0 (or NaN) is a slack cable (the first such cable is named).
-#[inline]
-fn check_slack(t: f64, tensions: &Tensions) -> Result<(), RunError> {
-    match tensions.iter().position(|&t| t <= 0.0 || t.is_nan()) {
-        None => Ok(()),
-        Some(i) => Err(RunError::SlackCable {
-            t,
-            cable: CableId(i),
-            tension: tensions[i],
-        }),
-    }
-}
-
-/// Samples the dense output on the grid t_k = k·Δt (computed, not accumulated, so the grid is
-/// exact and reproducible).
-struct Sampler {
-    series: TimeSeries,
-    y: Vec<f64>,
-    /// Number of the model's own channels.
-    model_channels: usize,
-    energy0: f64,
-    /// Sum of the energy changes of the model events so far [J].
-    event_energy: f64,
-    next: usize,
-    samples: usize,
-    period: f64,
-    /// End of the run [s]: the last sample is taken there, when the integration reaches it.
-    t_final: f64,
-}
-
-impl Sampler {
-    /// Appends every grid sample with t_k ≤ `t` (within the last accepted step).
-    fn sample_through<M: CableModel<D>, const D: usize>(
-        &mut self,
-        sys: &ClosedLoop<M, D>,
-        stepper: &dyn Stepper<ClosedLoop<M, D>>,
-        t: f64,
-    ) -> Result<(), RunError> {
-        let n = sys.model_len();
-        while self.next < self.samples {
-            let tk = self.next as f64 * self.period;
-            // The last sample is the end point itself (t_final may not be a multiple of Δt by ulps),
-            // taken once the integration has reached it.
-            let tk = if self.next + 1 == self.samples {
-                self.t_final
-            } else {
-                tk
-            };
-            if tk > t {
-                break;
-            }
-            if tk == stepper.time() {
-                self.y.copy_from_slice(stepper.state());
-            } else {
-                stepper.dense_output(tk, &mut self.y);
-            }
-            let y = &self.y;
-            let cmd = sys.command(tk, y);
-            check_slack(tk, &cmd.tensions)?;
-            let model_state = &y[..n];
-            let eff = sys.model.effector(model_state);
-            if !sys.robot().in_workspace(&eff.position) {
-                return Err(RunError::Workspace {
-                    t: tk,
-                    position: eff.position.as_slice().to_vec(),
-                });
-            }
-            let energy = sys.model.energy(model_state);
-            let c = n + sys.controller_len();
-            let (work, dissipated) = (y[c], y[c + 1]);
-            let residual = energy.total() - self.energy0 - work + dissipated - self.event_energy;
-            let m = self.model_channels;
-            let cables = cmd.tensions.len();
-            self.series.push_row_with(|row| {
-                let (common, rest) = row.split_at_mut(4 + D + cables);
-                let (own, energies) = rest.split_at_mut(m);
-                common[0] = tk;
-                common[1] = cmd.reference;
-                common[2..2 + D].copy_from_slice(eff.position.as_slice());
-                common[2 + D] = cmd.error;
-                common[3 + D] = cmd.force;
-                common[4 + D..].copy_from_slice(&cmd.tensions);
-                sys.model.channels(model_state, &cmd.tensions, own);
-                energies.copy_from_slice(&[
-                    energy.kinetic,
-                    energy.elastic,
-                    energy.gravity,
-                    work,
-                    dissipated,
-                    residual,
-                ]);
-            });
-            self.next += 1;
-        }
-        Ok(())
-    }
 }

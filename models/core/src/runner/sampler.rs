@@ -1,0 +1,94 @@
+//! Sampling the dense output on the exact grid t_k = k·Δt, with the energy balance of each
+//! sample.
+
+use super::RunError;
+use super::events::check_slack;
+use crate::closed_loop::ClosedLoop;
+use crate::model::CableModel;
+use crate::series::TimeSeries;
+use cdpr_numerics::Stepper;
+
+/// Samples the dense output on the grid t_k = k·Δt (computed, not accumulated, so the grid is
+/// exact and reproducible).
+pub(super) struct Sampler {
+    pub(super) series: TimeSeries,
+    pub(super) y: Vec<f64>,
+    /// Number of the model's own channels.
+    pub(super) model_channels: usize,
+    pub(super) energy0: f64,
+    /// Sum of the energy changes of the model events so far [J].
+    pub(super) event_energy: f64,
+    pub(super) next: usize,
+    pub(super) samples: usize,
+    pub(super) period: f64,
+    /// End of the run [s]: the last sample is taken there, when the integration reaches it.
+    pub(super) t_final: f64,
+}
+
+impl Sampler {
+    /// Appends every grid sample with t_k ≤ `t` (within the last accepted step).
+    pub(super) fn sample_through<M: CableModel<D>, const D: usize>(
+        &mut self,
+        sys: &ClosedLoop<M, D>,
+        stepper: &dyn Stepper<ClosedLoop<M, D>>,
+        t: f64,
+    ) -> Result<(), RunError> {
+        let n = sys.model_len();
+        while self.next < self.samples {
+            let tk = self.next as f64 * self.period;
+            // The last sample is the end point itself (t_final may not be a multiple of Δt by ulps),
+            // taken once the integration has reached it.
+            let tk = if self.next + 1 == self.samples {
+                self.t_final
+            } else {
+                tk
+            };
+            if tk > t {
+                break;
+            }
+            if tk == stepper.time() {
+                self.y.copy_from_slice(stepper.state());
+            } else {
+                stepper.dense_output(tk, &mut self.y);
+            }
+            let y = &self.y;
+            let cmd = sys.command(tk, y);
+            check_slack(tk, &cmd.tensions)?;
+            let model_state = &y[..n];
+            let eff = sys.model.effector(model_state);
+            if !sys.robot().in_workspace(&eff.position) {
+                return Err(RunError::Workspace {
+                    t: tk,
+                    position: eff.position.as_slice().to_vec(),
+                });
+            }
+            let energy = sys.model.energy(model_state);
+            let c = n + sys.controller_len();
+            let (work, dissipated) = (y[c], y[c + 1]);
+            let residual = energy.total() - self.energy0 - work + dissipated - self.event_energy;
+            let m = self.model_channels;
+            let cables = cmd.tensions.len();
+            self.series.push_row_with(|row| {
+                let (common, rest) = row.split_at_mut(4 + D + cables);
+                let (own, energies) = rest.split_at_mut(m);
+                common[0] = tk;
+                common[1] = cmd.reference;
+                common[2..2 + D].copy_from_slice(eff.position.as_slice());
+                common[2 + D] = cmd.error;
+                common[3 + D] = cmd.force;
+                common[4 + D..].copy_from_slice(&cmd.tensions);
+                sys.model.channels(model_state, &cmd.tensions, own);
+                energies.copy_from_slice(&[
+                    energy.kinetic,
+                    energy.elastic,
+                    energy.gravity,
+                    work,
+                    dissipated,
+                    residual,
+                ]);
+            });
+            self.next += 1;
+        }
+        Ok(())
+    }
+}
