@@ -38,6 +38,16 @@ impl ModelKind {
     /// The models whose cables have mass (and axial modes, pulley dynamics, an implicit path).
     pub const MASSIVE: [ModelKind; 2] = [ModelKind::Lumped, ModelKind::Fe];
 
+    /// Whether the model's cables have mass (one of [`ModelKind::MASSIVE`]).
+    pub fn has_cable_mass(self) -> bool {
+        Self::MASSIVE.contains(&self)
+    }
+
+    /// The model's place in [`ModelKind::ALL`] (for per-model tables such as figure colours).
+    pub fn index(self) -> usize {
+        Self::ALL.iter().position(|&k| k == self).unwrap_or(0)
+    }
+
     /// The scenario file's spelling, also the model's name in files and tables.
     pub fn name(self) -> &'static str {
         match self {

@@ -15,7 +15,6 @@ mod figures;
 mod heatmap;
 mod modes;
 mod output;
-mod pool;
 mod report;
 mod shaping;
 mod simulate;

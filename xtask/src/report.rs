@@ -17,7 +17,8 @@ use cdpr_bench::core::runner::Run;
 use cdpr_bench::core::scenario::Scenario;
 use cdpr_bench::core::trajectory::Step5;
 use cdpr_bench::numerics::eigen::Mode;
-use cdpr_verify::acceptance::{self, Check, ModelResult};
+use cdpr_studies::paper::PaperRuns;
+use cdpr_verify::acceptance::Check;
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
 use std::io::IsTerminal;
@@ -68,84 +69,42 @@ fn bars(kinds: &[ModelKind]) -> (MultiProgress, Vec<ProgressBar>) {
     (multi, bars)
 }
 
-/// Runs and measures one model of the scenario.
-fn run_model(scenario: &Scenario, kind: ModelKind, bar: &ProgressBar) -> Result<Outcome> {
-    let outcome = cdpr_bench::assess(scenario, &mut |f| bar.set_position((f * 1000.0) as u64))
-        .map_err(|e| anyhow::anyhow!("{kind} model: {e}"))?;
-    bar.finish();
-    Ok(outcome)
-}
-
 pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     let base = load_scenario(scenario, None)?;
     crate::simulate::writable_out(out)?;
-    let kinds = ModelKind::ALL;
-    let (_multi, bars) = bars(&kinds);
-    // One thread per model: the machine's cores run them side by side; results keep model order.
-    let results: Vec<Result<Outcome>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = kinds
-            .iter()
-            .zip(&bars)
-            .map(|(&kind, bar)| {
-                let base = &base;
-                scope.spawn(move || {
-                    let s = cdpr_bench::with_model_kind(base, kind)?;
-                    run_model(&s, kind, bar)
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| {
-                h.join()
-                    .unwrap_or_else(|_| bail!("a model thread panicked"))
-            })
-            .collect()
-    });
-    let outcomes = results.into_iter().collect::<Result<Vec<Outcome>>>()?;
-    // The report compares every model's end state: without it there is no report.
-    let ends = outcomes
-        .iter()
-        .map(|o| {
-            o.end.state().cloned().ok_or_else(|| {
-                anyhow::anyhow!(
-                    "{} model: the modal analysis at x2 {}: {}",
-                    o.kind,
-                    o.end.status(),
-                    o.end.reason().unwrap_or_default()
-                )
-            })
-        })
-        .collect::<Result<Vec<EndState>>>()?;
-
-    let eq15 = cdpr_bench::eq15_at_end(&base);
-    let axial_mode = cdpr_bench::mode_as_integrated(&base, acceptance::LUMPED_AXIAL_MODE);
-    let views: Vec<ModelResult> = outcomes
-        .iter()
-        .map(|o| ModelResult::of(o, axial_mode))
-        .collect();
-    let checks = acceptance::table(eq15, &views);
+    let (_multi, bars) = bars(&ModelKind::ALL);
+    let paper =
+        cdpr_studies::paper::compute(&base, &|k, f| bars[k].set_position((f * 1000.0) as u64))?;
+    for bar in &bars {
+        bar.finish();
+    }
+    let PaperRuns {
+        outcomes,
+        ends,
+        eq15_rad_s: eq15,
+        checks,
+    } = paper;
 
     let names = write_figures(&base, &outcomes, eq15, out)?;
     // Every model's modes at x1 and x2 and the axial-damping sweep (~1 s).
     let (x1, x2) = (base.trajectory.x1, base.trajectory.x2);
-    let modes = crate::modes::compute(&base, &[x1, x2], x2)?;
-    modes.write_files(out)?;
+    let modes = cdpr_studies::modes::compute(&base, &[x1, x2], x2)?;
+    crate::modes::write_files(&modes, out)?;
     // Every controller on every model (the leaderboard, ~2 s on two cores).
-    let control = crate::control::compute(&base)?;
-    let control_figures = control.write(out)?;
+    let control = cdpr_studies::control::compute(&base)?;
+    let control_figures = crate::control::write(&control, out)?;
     // Every input shaper on every model with the paper's PID (~40 s on two cores).
-    let shaping = crate::shaping::compute(&base)?;
-    let shaping_figures = shaping.write(out)?;
+    let shaping = cdpr_studies::shaping::compute(&base)?;
+    let shaping_figures = crate::shaping::write(&shaping, out)?;
     // The mass × move-time parameter studies on every model: controllers (150 points) and
     // shapers (225 points), ~45 s on two cores.
     let mut study_section = String::from(
         "## Parameter studies\n\nBeyond the paper: the paper's move x 0.5 → 0.6 m with effector mass \
          0.25–4 kg (log) × move end t2 0.1–0.5 s on each cable model, samples every 0.1 ms.\n\n",
     );
-    for spec in crate::sweep_study::STUDIES {
-        let study = crate::sweep_study::compute(spec, &base, out)?;
-        let figures = study.write(out)?;
+    for spec in cdpr_studies::sweeps::STUDIES {
+        let study = cdpr_studies::sweeps::compute(spec, &base, out)?;
+        let figures = crate::sweep_study::write(&study, out)?;
         study_section.push_str(&study.section(&figures));
     }
     write_json(
@@ -430,7 +389,7 @@ fn write_markdown(
     checks: &[Check],
     eq15: f64,
     figures: &[(String, String)],
-    modes: &crate::modes::ModesReport,
+    modes: &cdpr_studies::modes::ModesReport,
     control: &str,
     out: &Path,
 ) -> Result<()> {

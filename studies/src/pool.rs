@@ -1,6 +1,6 @@
 //! Independent runs on every core: a shared counter hands out jobs, results keep the jobs' order.
 
-use anyhow::{Result, anyhow};
+use crate::{Result, StudyError};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -30,7 +30,7 @@ pub fn map<T: Sync, R: Send>(jobs: &[T], f: impl Fn(&T) -> R + Sync) -> Result<V
             slot.into_inner()
                 .ok()
                 .flatten()
-                .ok_or_else(|| anyhow!("a worker panicked before finishing its run"))
+                .ok_or(StudyError::WorkerPanicked)
         })
         .collect()
 }
