@@ -25,52 +25,8 @@
 //! of the step (one right-hand-side evaluation per step), third order, above the method's own.
 
 use crate::norms::max_norm;
-use crate::ode::{IntegratorError, MatrixCost, OdeSystem, SolverStats, Stepper};
+use crate::ode::{IntegratorError, SecondOrderSystem, SolverStats, Stepper};
 use crate::sparse::IterationMatrix;
-
-/// A second-order system with a first-order tail, as the implicit integrator sees it.
-///
-/// State layout `[q (n) | q' (n) | tail]`; [`OdeSystem::rhs`] is the same system in first-order
-/// form (it gives the consistent initial acceleration and the dense output's derivatives).
-pub trait SecondOrderSystem: OdeSystem {
-    /// Number n of generalised coordinates q.
-    fn dofs(&self) -> usize;
-    /// The (row, col) entries of the iteration matrix that may be non-zero, fixed for the run.
-    fn iteration_pattern(&self) -> Vec<(usize, usize)>;
-    /// Unknowns that couple distant parts of that pattern (a controller feeding one coordinate
-    /// back into far rows): the matrix eliminates them last, through a Schur complement, so the
-    /// rest keeps its chain structure ([`IterationMatrix::with_coupled`]).
-    fn coupled_unknowns(&self) -> Vec<usize> {
-        Vec::new()
-    }
-    /// A step attempt from (t, y) of size h begins: the system records what its tail update and
-    /// its residual need from the step's start.
-    fn begin_step(&mut self, t: f64, y: &[f64], h: f64);
-    /// R = M(q) q'' − F(t, q, q', …) (n rows) for the iterate whose q, q' are `y[..2n]`.
-    fn residual(&mut self, t: f64, y: &[f64], qdd: &[f64], r: &mut [f64]);
-    /// S = ∂R/∂q'' + c_v ∂R/∂q' + c_q ∂R/∂q at the iterate, in the order of
-    /// [`Self::iteration_pattern`] (duplicates are summed). Returns what it cost.
-    #[allow(clippy::too_many_arguments)]
-    fn iteration_matrix(
-        &mut self,
-        t: f64,
-        y: &[f64],
-        qdd: &[f64],
-        c_v: f64,
-        c_q: f64,
-        values: &mut [f64],
-    ) -> MatrixCost;
-    /// Writes the tail `y[2n..]` at the end t of an accepted step whose q, q' are `y[..2n]`.
-    fn end_step(&mut self, t: f64, y: &mut [f64]);
-    /// The tail's rate at (t, y) into `out` (the dense output's derivative; q' and q'' come from
-    /// the step itself, so no full right-hand side is evaluated per step).
-    fn tail_rate(&mut self, t: f64, y: &[f64], out: &mut [f64]);
-    /// Round-off level of max |R| at the state `y` (0 if negligible): Newton is not asked for a
-    /// residual below it.
-    fn residual_round_off(&self, _y: &[f64]) -> f64 {
-        0.0
-    }
-}
 
 /// Settings of [`GeneralizedAlpha`].
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -44,7 +44,5 @@ pub mod riccati;
 pub mod sparse;
 
 pub use dopri5::{Dopri5, Dopri5Options};
-pub use generalized_alpha::{
-    AlphaCoefficients, GeneralizedAlpha, GeneralizedAlphaOptions, SecondOrderSystem,
-};
-pub use ode::{IntegratorError, MatrixCost, OdeSystem, SolverStats, Stepper};
+pub use generalized_alpha::{AlphaCoefficients, GeneralizedAlpha, GeneralizedAlphaOptions};
+pub use ode::{IntegratorError, MatrixCost, OdeSystem, SecondOrderSystem, SolverStats, Stepper};

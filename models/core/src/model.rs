@@ -129,6 +129,30 @@ pub fn check_effector_x(effector_x: f64, anchor_distance: f64) -> Result<(), Mod
     }
 }
 
+/// What the planar massive models' statics take from a rest rule: the pinned effector x (the
+/// rule must pin x alone, as the paper's does; checked to lie between the pulleys) and the
+/// rule's pretension ΣT (its tensions at a zero parameter) [m, N].
+pub fn planar_rest(
+    rule: &dyn RestRule<2>,
+    anchor_distance: f64,
+    model: &str,
+) -> Result<(f64, f64), ModelError> {
+    let effector_x = match rule.pinned() {
+        &[(0, x)] => x,
+        pinned => {
+            return Err(ModelError::Parameter {
+                name: "rest rule",
+                value: pinned.len() as f64,
+                allowed: format!(
+                    "the effector's x pinned and one parameter: the planar {model} statics"
+                ),
+            });
+        }
+    };
+    check_effector_x(effector_x, anchor_distance)?;
+    Ok((effector_x, rule.tensions(&[0.0]).iter().sum()))
+}
+
 /// How the robot and its controller hold the effector at rest (MODELS.md §2), which a model's
 /// statics solves with: effector coordinates pinned at values, and the commanded tensions as a
 /// function of as many unknown parameters, affine in them. The paper's PID: x pinned, F0 free,

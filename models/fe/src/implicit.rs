@@ -16,7 +16,7 @@
 //! is linear and exact.
 
 use crate::element::{self, Chord, ElementState};
-use crate::{E_OUT, Fe};
+use crate::{Fe, TOWARD_REEL};
 use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
 use cdpr_numerics::differences::central_step;
 use nalgebra::Vector2;
@@ -130,7 +130,7 @@ impl Fe {
                 r.copy_from_slice(&[ra.x, ra.y, rb.x, rb.y, rl]);
             }
             Block::Stored { cable } => {
-                let e_out = Vector2::new(E_OUT[cable], 0.0);
+                let e_out = Vector2::new(TOWARD_REEL[cable], 0.0);
                 let pulley = self.pulley(cable);
                 let s = ElementState::new(
                     (pulley + e_out * q[0], e_out * v[0]),
@@ -168,7 +168,7 @@ impl Fe {
     /// ρ'' = `a_rho`, l'' = `a_l`: the kernel's R-node terms projected on e_out (tension left out).
     #[inline(always)]
     fn stored_rows(&self, cable: usize, s: &ElementState, a_rho: f64, a_l: f64) -> [f64; 2] {
-        let e_out = Vector2::new(E_OUT[cable], 0.0);
+        let e_out = Vector2::new(TOWARD_REEL[cable], 0.0);
         let (r_reel, _, r_l) = element::residual_at_chord(
             &self.material,
             &self.stored_coefficients,

@@ -39,8 +39,8 @@ use nalgebra::Vector2;
 pub use params::{FeMass, FeStored, Params};
 use solve::ChainSystem;
 
-/// Direction from each pulley towards its reel, e_out,i (MODELS.md FE.2).
-pub const E_OUT: [f64; 2] = [-1.0, 1.0];
+/// Direction from each pulley towards its reel along x, e_out,i of MODELS.md FE.2.
+pub const TOWARD_REEL: [f64; 2] = [-1.0, 1.0];
 
 /// What the N free elements of a span share: l' [m/s], h = l_i/N [m], 1/h [1/m] and h' = 1/N.
 #[derive(Debug, Clone, Copy)]
@@ -288,7 +288,7 @@ impl Fe {
         let ri = self.rho_index(cable)?;
         let np = self.positions_len();
         let li = self.l_index(cable);
-        let e_out = Vector2::new(E_OUT[cable], 0.0);
+        let e_out = Vector2::new(TOWARD_REEL[cable], 0.0);
         let a = self.pulley(cable);
         Some(ElementState::new(
             (a + e_out * y[ri], e_out * y[np + ri]),
@@ -363,7 +363,7 @@ impl Fe {
                         &s,
                         self.axial_damping,
                     );
-                    let e_out = Vector2::new(E_OUT[cable], 0.0);
+                    let e_out = Vector2::new(TOWARD_REEL[cable], 0.0);
                     let rb = lb + 1;
                     sys.d[rb][rb] += t.m_diag;
                     let m_rho_l = t.m_al.dot(&e_out);

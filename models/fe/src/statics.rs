@@ -146,19 +146,8 @@ fn problem<'a>(
     model: &'a mut Fe,
     rule: &'a dyn RestRule<2>,
 ) -> Result<(Problem<'a>, Vec<f64>), ModelError> {
-    let effector_x = match rule.pinned() {
-        &[(0, x)] => x,
-        pinned => {
-            return Err(ModelError::Parameter {
-                name: "rest rule",
-                value: pinned.len() as f64,
-                allowed: "the effector's x pinned and one parameter: the planar FE statics".into(),
-            });
-        }
-    };
-    // The tensions at a zero parameter: the rule's pretension (the paper's ΣT, split evenly).
-    let tension_sum: f64 = rule.tensions(&[0.0]).iter().sum();
-    cdpr_core::model::check_effector_x(effector_x, model.anchor_distance)?;
+    let (effector_x, tension_sum) =
+        cdpr_core::model::planar_rest(rule, model.anchor_distance, "FE")?;
     let d = model.anchor_distance;
     let n = model.elements;
     let np = model.positions_len();

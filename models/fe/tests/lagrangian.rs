@@ -9,7 +9,7 @@ use cdpr_core::Vector2;
 use cdpr_core::model::{CableModel, SplitRule};
 use cdpr_core::scenario::Scenario;
 use cdpr_fe::element::{self, ElementState, MassCoefficients, Material};
-use cdpr_fe::{E_OUT, Fe, FeMass, FeStored};
+use cdpr_fe::{Fe, FeMass, FeStored, TOWARD_REEL};
 use common::*;
 use proptest::prelude::*;
 
@@ -237,7 +237,7 @@ fn material_kinetic(m: &Fe, y: &[f64], dt: f64) -> f64 {
         if sigma < l0 - l {
             let rho = q[m.rho_index(cable).unwrap()];
             let zeta = sigma / (l0 - l);
-            let r = a + Vector2::new(E_OUT[cable], 0.0) * rho;
+            let r = a + Vector2::new(TOWARD_REEL[cable], 0.0) * rho;
             r * (1.0 - zeta) + a * zeta
         } else {
             let xi = (sigma - l0 + l) / l;

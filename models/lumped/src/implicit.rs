@@ -37,7 +37,7 @@ const TANGENT_REFRESH_PRICE: u64 = 48;
 impl Lumped {
     /// Coordinates (x, z indices) of node j of `cable` (the effector at j = N).
     fn coordinates(&self, cable: usize, j: usize) -> [usize; 2] {
-        [self.xi(cable, j), self.zi(cable, j)]
+        [self.x_index(cable, j), self.z_index(cable, j)]
     }
 
     /// Index into [`SecondOrderForm::iteration_pattern`] of entry (row `r`, column `c`; 0 = x,
@@ -169,12 +169,12 @@ impl Lumped {
 impl Lumped {
     /// Index of the effector's x among q.
     pub fn effector_x(&self) -> usize {
-        self.xi(0, self.elements)
+        self.x_index(0, self.elements)
     }
 
     /// Index of the effector's z among q.
     pub fn effector_z(&self) -> usize {
-        self.zi(0, self.elements)
+        self.z_index(0, self.elements)
     }
 }
 
@@ -192,7 +192,7 @@ impl SecondOrderForm for Lumped {
     }
     /// The commanded tension pulls the reel end P_0 along e_out (horizontal).
     fn tension_rows(&self) -> Vec<usize> {
-        vec![self.xi(0, 0), self.xi(1, 0)]
+        vec![self.x_index(0, 0), self.x_index(1, 0)]
     }
 
     fn iteration_pattern(&self) -> Vec<(usize, usize)> {
@@ -350,9 +350,9 @@ mod tests {
             for cable in 0..2 {
                 for j in 0..n {
                     let phase = f64::from(seed) + (cable * n + j) as f64;
-                    state[model.xi(cable, j)] += shake * (1.7 * phase).sin();
+                    state[model.x_index(cable, j)] += shake * (1.7 * phase).sin();
                     if j >= model.stored[cable] {
-                        state[model.zi(cable, j)] += shake * (2.3 * phase).cos();
+                        state[model.z_index(cable, j)] += shake * (2.3 * phase).cos();
                     }
                 }
             }

@@ -91,8 +91,8 @@ pub fn spring_tension(stiffness: f64, segment: f64, damping: f64, length: f64, r
     (stiffness * stretch + damping * rate).max(0.0)
 }
 
-/// Direction from each pulley towards its reel, e_out,i (MODELS.md §4).
-pub const E_OUT: [f64; 2] = [-1.0, 1.0];
+/// Direction from each pulley towards its reel along x, e_out,i of MODELS.md §4.
+pub const TOWARD_REEL: [f64; 2] = [-1.0, 1.0];
 
 impl Lumped {
     /// The model with the scenario's robot, cable and element count; r_i are set by
@@ -153,7 +153,7 @@ impl Lumped {
     }
 
     /// Index of the x coordinate of node `j` of `cable` (j = N is the effector).
-    pub fn xi(&self, cable: usize, j: usize) -> usize {
+    pub fn x_index(&self, cable: usize, j: usize) -> usize {
         if j == self.elements {
             4 * self.elements
         } else {
@@ -162,7 +162,7 @@ impl Lumped {
     }
 
     /// Index of the z coordinate of node `j` of `cable` (j = N is the effector).
-    pub fn zi(&self, cable: usize, j: usize) -> usize {
+    pub fn z_index(&self, cable: usize, j: usize) -> usize {
         if j == self.elements {
             4 * self.elements + 1
         } else {
@@ -172,13 +172,16 @@ impl Lumped {
 
     /// Position of node `j` of `cable` (the effector at j = N) [m].
     pub fn node(&self, y: &[f64], cable: usize, j: usize) -> Vector2<f64> {
-        Vector2::new(y[self.xi(cable, j)], y[self.zi(cable, j)])
+        Vector2::new(y[self.x_index(cable, j)], y[self.z_index(cable, j)])
     }
 
     /// Velocity of node `j` of `cable` [m/s].
     pub fn node_velocity(&self, y: &[f64], cable: usize, j: usize) -> Vector2<f64> {
         let np = self.positions_len();
-        Vector2::new(y[np + self.xi(cable, j)], y[np + self.zi(cable, j)])
+        Vector2::new(
+            y[np + self.x_index(cable, j)],
+            y[np + self.z_index(cable, j)],
+        )
     }
 
     #[inline]
@@ -241,7 +244,7 @@ impl Lumped {
         let mut effector = Vector2::new(0.0, -self.effector_mass * self.gravity);
         for cable in 0..2 {
             let mut s = std::mem::take(&mut self.scratch[cable]);
-            let (bx, bz) = (self.xi(cable, 0), self.zi(cable, 0));
+            let (bx, bz) = (self.x_index(cable, 0), self.z_index(cable, 0));
             let (x, z) = (&y[bx..bx + n], &y[bz..bz + n]);
             let (vx, vz) = (&y[np + bx..np + bx + n], &y[np + bz..np + bz + n]);
             let m = n - 1;
@@ -285,7 +288,7 @@ impl Lumped {
             }
             let (fx, rest) = out[bx..].split_at_mut(n);
             let fz = &mut rest[..n];
-            fx[0] = s.ax[0] + tensions[cable] * E_OUT[cable];
+            fx[0] = s.ax[0] + tensions[cable] * TOWARD_REEL[cable];
             fz[0] = s.az[0];
             for j in 1..n {
                 fx[j] = s.ax[j] + s.bx[j - 1];
@@ -354,7 +357,7 @@ impl CableModel<2> for Lumped {
         dv[4 * n] /= self.effector_mass;
         dv[4 * n + 1] /= self.effector_mass;
         for cable in 0..2 {
-            let bz = self.zi(cable, 0);
+            let bz = self.z_index(cable, 0);
             dq[bz..bz + self.stored[cable]].fill(0.0);
         }
     }
@@ -368,7 +371,7 @@ impl CableModel<2> for Lumped {
 
     /// The reel end P_0 moving along e_out takes cable in.
     fn reel_speeds(&self, y: &[f64]) -> PerCable {
-        PerCable::from_fn(2, |c| self.node_velocity(y, c, 0).x * E_OUT[c])
+        PerCable::from_fn(2, |c| self.node_velocity(y, c, 0).x * TOWARD_REEL[c])
     }
 
     fn energy(&self, y: &[f64]) -> Energy {
@@ -384,7 +387,7 @@ impl CableModel<2> for Lumped {
         };
         let mut e = Energy::default();
         for cable in 0..2 {
-            let (bx, bz) = (self.xi(cable, 0), self.zi(cable, 0));
+            let (bx, bz) = (self.x_index(cable, 0), self.z_index(cable, 0));
             let (x, z) = (&y[bx..bx + n], &y[bz..bz + n]);
             let (vx, vz) = (&y[np + bx..np + bx + n], &y[np + bz..np + bz + n]);
             e.kinetic += 0.5 * m * (sum_of_squares(vx) + sum_of_squares(vz));

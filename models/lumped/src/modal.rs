@@ -11,7 +11,7 @@ impl Lumped {
         let n = self.elements;
         let mut layout = ModalLayout {
             dofs: vec![Dof::Effector {
-                coordinates: vec![self.xi(0, n), self.zi(0, n)],
+                coordinates: vec![self.x_index(0, n), self.z_index(0, n)],
                 mass: self.effector_mass,
             }],
             frozen: Vec::new(),
@@ -19,7 +19,7 @@ impl Lumped {
         for cable in 0..2 {
             let r = self.stored()[cable];
             for j in 0..n {
-                let (x, z) = (self.xi(cable, j), self.zi(cable, j));
+                let (x, z) = (self.x_index(cable, j), self.z_index(cable, j));
                 if j < r {
                     layout.frozen.push(z);
                     layout.dofs.push(Dof::Axial {

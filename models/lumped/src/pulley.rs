@@ -11,7 +11,7 @@
 //! leaving the reel, or a free node other than the first one passing the pulley, breaks the
 //! ordering the model relies on and stops the run as a modelling error.
 
-use crate::{E_OUT, Lumped};
+use crate::{Lumped, TOWARD_REEL};
 use cdpr_core::model::{CableModel, ModelError, ModelEvent};
 
 /// Offset ε that keeps the side rule unambiguous after an event [m].
@@ -25,13 +25,13 @@ pub(crate) const EVENT_COUNT: usize = 2 * PER_CABLE;
 /// The side rule's signed distance beyond `cable`'s pulley along e_out of a node at x [m]
 /// (> 0: on the reel side), as a function of x (the pulley looked up once).
 fn beyond_at(model: &Lumped, cable: usize) -> impl Fn(f64) -> f64 {
-    let (pulley, e_out) = (model.pulley(cable).x, E_OUT[cable]);
+    let (pulley, e_out) = (model.pulley(cable).x, TOWARD_REEL[cable]);
     move |x| (x - pulley) * e_out
 }
 
 /// Signed distance of node j beyond the pulley along e_out (> 0: on the reel side) [m].
 pub(crate) fn beyond(model: &Lumped, y: &[f64], cable: usize, j: usize) -> f64 {
-    beyond_at(model, cable)(y[model.xi(cable, j)])
+    beyond_at(model, cable)(y[model.x_index(cable, j)])
 }
 
 /// All event functions, positive while nothing happens (see [`CableModel::event_functions`]).
@@ -41,7 +41,7 @@ pub(crate) fn event_functions(model: &Lumped, y: &[f64], out: &mut [f64]) {
         let r = model.stored()[cable];
         let g = &mut out[PER_CABLE * cable..PER_CABLE * (cable + 1)];
         // The cable's nodes' x, contiguous.
-        let start = model.xi(cable, 0);
+        let start = model.x_index(cable, 0);
         let x = &y[start..start + n];
         let beyond = beyond_at(model, cable);
         g[0] = if r > 0 { beyond(x[r - 1]) } else { 1.0 };
@@ -97,14 +97,14 @@ pub(crate) fn apply_event(
                 });
             }
             let j = r - 1;
-            y[model.xi(cable, j)] = pulley - PULLEY_OFFSET * E_OUT[cable];
+            y[model.x_index(cable, j)] = pulley - PULLEY_OFFSET * TOWARD_REEL[cable];
             stored[cable] = r - 1;
             (j, "leaves the reel")
         }
         1 => {
             let j = r;
-            let (ix, iz) = (model.xi(cable, j), model.zi(cable, j));
-            y[ix] = pulley + PULLEY_OFFSET * E_OUT[cable];
+            let (ix, iz) = (model.x_index(cable, j), model.z_index(cable, j));
+            y[ix] = pulley + PULLEY_OFFSET * TOWARD_REEL[cable];
             y[iz] = 0.0;
             y[np + iz] = 0.0;
             stored[cable] = r + 1;

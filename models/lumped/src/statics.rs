@@ -14,7 +14,7 @@
 //! all of them (the docs of each say what removing it alone brings back).
 
 use crate::pulley::beyond;
-use crate::{E_OUT, Lumped};
+use crate::{Lumped, TOWARD_REEL};
 use cdpr_core::model::{CableModel, Equilibrium, ModelError, RestRule};
 use cdpr_core::robot::Tensions;
 use cdpr_core::second_order::SecondOrderForm;
@@ -47,13 +47,13 @@ impl<'a> Problem<'a> {
         let mut map = Vec::new();
         for cable in 0..2 {
             for j in 0..model.elements {
-                map.push(model.xi(cable, j));
+                map.push(model.x_index(cable, j));
                 if j >= model.stored()[cable] {
-                    map.push(model.zi(cable, j));
+                    map.push(model.z_index(cable, j));
                 }
             }
         }
-        map.push(model.zi(0, model.elements));
+        map.push(model.z_index(0, model.elements));
         let mut unknown = vec![None; model.positions_len()];
         for (k, &i) in map.iter().enumerate() {
             unknown[i] = Some(k);
@@ -150,7 +150,7 @@ impl StaticProblem for Problem<'_> {
         let slope = self.rule.slope(0);
         for (cable, row) in self.model.tension_rows().into_iter().enumerate() {
             if self.row_of(row).is_some() {
-                values[at] = slope[cable] * E_OUT[cable];
+                values[at] = slope[cable] * TOWARD_REEL[cable];
                 at += 1;
             }
         }
@@ -179,12 +179,13 @@ impl StaticProblem for Problem<'_> {
                 let j = r - 1;
                 keep(
                     beyond(model, &self.y, cable, j),
-                    -step(model.xi(cable, j)) * E_OUT[cable],
+                    -step(model.x_index(cable, j)) * TOWARD_REEL[cable],
                 );
             }
             if r < model.elements {
                 let offset = model.node(&self.y, cable, r) - model.pulley(cable);
-                let moved = Vector2::new(step(model.xi(cable, r)), step(model.zi(cable, r)));
+                let moved =
+                    Vector2::new(step(model.x_index(cable, r)), step(model.z_index(cable, r)));
                 keep(offset.norm(), moved.norm());
             }
         }
@@ -228,10 +229,10 @@ fn guess(model: &mut Lumped, effector: Vector2<f64>, tension: f64, ea: f64) -> V
             let p = if s >= 0.0 {
                 a + u * (s * stretch)
             } else {
-                a + Vector2::new(E_OUT[cable], 0.0) * (-s * stretch)
+                a + Vector2::new(TOWARD_REEL[cable], 0.0) * (-s * stretch)
             };
-            y[model.xi(cable, j)] = p.x;
-            y[model.zi(cable, j)] = if s >= 0.0 { p.y } else { 0.0 };
+            y[model.x_index(cable, j)] = p.x;
+            y[model.z_index(cable, j)] = if s >= 0.0 { p.y } else { 0.0 };
         }
     }
     y[4 * n] = effector.x;
@@ -260,7 +261,7 @@ const KINK_KEEP: f64 = 0.1;
 /// cannot cross).
 fn reclassify(model: &mut Lumped, y: &mut [f64], stored: [usize; 2], effector_x: f64) {
     let n = model.elements;
-    let effector = Vector2::new(effector_x, y[model.zi(0, n)]);
+    let effector = Vector2::new(effector_x, y[model.z_index(0, n)]);
     for cable in 0..2 {
         let (old, new) = (model.stored()[cable], stored[cable]);
         if old == new {
@@ -272,12 +273,12 @@ fn reclassify(model: &mut Lumped, y: &mut [f64], stored: [usize; 2], effector_x:
             .norm()
             .max(PULLEY_GAP * model.segment);
         let p = if new > old {
-            a + Vector2::new(E_OUT[cable] * gap, 0.0)
+            a + Vector2::new(TOWARD_REEL[cable] * gap, 0.0)
         } else {
             a + (effector - a).normalize() * gap
         };
-        y[model.xi(cable, j)] = p.x;
-        y[model.zi(cable, j)] = p.y;
+        y[model.x_index(cable, j)] = p.x;
+        y[model.z_index(cable, j)] = p.y;
     }
     model.set_stored(stored);
 }
@@ -333,20 +334,8 @@ pub(crate) fn equilibrium(
     model: &mut Lumped,
     rule: &dyn RestRule<2>,
 ) -> Result<Equilibrium, ModelError> {
-    let effector_x = match rule.pinned() {
-        &[(0, x)] => x,
-        pinned => {
-            return Err(ModelError::Parameter {
-                name: "rest rule",
-                value: pinned.len() as f64,
-                allowed: "the effector's x pinned and one parameter: the planar lumped statics"
-                    .into(),
-            });
-        }
-    };
-    // The tensions at a zero parameter: the rule's pretension (the paper's ΣT, split evenly).
-    let tension_sum: f64 = rule.tensions(&[0.0]).iter().sum();
-    cdpr_core::model::check_effector_x(effector_x, model.anchor_distance)?;
+    let (effector_x, tension_sum) =
+        cdpr_core::model::planar_rest(rule, model.anchor_distance, "lumped")?;
     let d = model.anchor_distance;
     // Massless-cable sag as the effector's starting depth; the cable weight adds ~1 %.
     let weight = model.effector_mass * model.gravity;

@@ -26,9 +26,9 @@ fn damped_energy_balance_holds() {
     let eq = m.equilibrium(&SplitRule::new(0.5, 200.0)).unwrap();
     let np = m.positions_len();
     let mut y = eq.state.clone();
-    y[np + m.xi(0, 0)] = -0.5;
-    y[np + m.xi(1, 0)] = 0.5;
-    y[np + m.zi(0, m.elements)] = 0.05;
+    y[np + m.x_index(0, 0)] = -0.5;
+    y[np + m.x_index(1, 0)] = 0.5;
+    y[np + m.z_index(0, m.elements)] = 0.05;
     assert!(m.dissipation(&y) >= 0.0);
     y.extend_from_slice(&[0.0; 4]);
     let mut sys = ClosedLoop::new(m, &s).unwrap();

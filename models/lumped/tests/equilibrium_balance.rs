@@ -6,7 +6,7 @@
 
 use cdpr_core::model::{CableModel, SplitRule};
 use cdpr_core::scenario::Scenario;
-use cdpr_lumped::{E_OUT, Lumped, Params};
+use cdpr_lumped::{Lumped, Params, TOWARD_REEL};
 use nalgebra::Vector2;
 use proptest::prelude::*;
 
@@ -74,7 +74,7 @@ fn largest_imbalance(m: &Lumped, y: &[f64], commanded: [f64; 2], t: &Totals, wei
         let r = m.stored()[cable];
         let a = m.pulley(cable);
         let node = |j: usize| m.node(y, cable, j);
-        force[0][cable].x += commanded[cable] * E_OUT[cable];
+        force[0][cable].x += commanded[cable] * TOWARD_REEL[cable];
         for j in 0..n {
             // Spring j from P_j to P_{j+1}; the straddling spring r − 1 runs over the pulley.
             let (from_a, to_b, length) = if j + 1 == r {

@@ -8,7 +8,7 @@ use cdpr_core::model::{CableModel, Equilibrium, SplitRule};
 use cdpr_core::robot::{CableId, Tensions};
 use cdpr_core::runner::{RunOptions, simulate, simulate_from};
 use cdpr_core::scenario::Scenario;
-use cdpr_lumped::{E_OUT, Lumped, Params};
+use cdpr_lumped::{Lumped, Params, TOWARD_REEL};
 use cdpr_numerics::{Dopri5, Dopri5Options, OdeSystem};
 use proptest::prelude::*;
 
@@ -22,7 +22,7 @@ fn tensions(tension_sum: f64, force: f64) -> Tensions {
 
 /// (P_j − A_i)·e_out,i: > 0 beyond the pulley (stored side).
 fn beyond(m: &Lumped, y: &[f64], cable: usize, j: usize) -> f64 {
-    (m.node(y, cable, j).x - m.pulley(cable).x) * E_OUT[cable]
+    (m.node(y, cable, j).x - m.pulley(cable).x) * TOWARD_REEL[cable]
 }
 
 fn side_rule_holds(m: &Lumped, y: &[f64]) -> bool {
@@ -177,11 +177,11 @@ fn damped_relaxation_reaches_the_newton_equilibrium() {
         for c in 0..2 {
             for j in m.stored()[c]..m.elements {
                 let k = (c * 97 + j * 31) as f64;
-                y[m.xi(c, j)] += 1e-5 * (k.sin());
-                y[m.zi(c, j)] += 1e-5 * (k.cos());
+                y[m.x_index(c, j)] += 1e-5 * (k.sin());
+                y[m.z_index(c, j)] += 1e-5 * (k.cos());
             }
         }
-        y[m.zi(0, m.elements)] += 1e-5;
+        y[m.z_index(0, m.elements)] += 1e-5;
         let mut sys = Relaxation {
             tensions: tensions(200.0, eq.force()),
             model: m.clone(),
@@ -237,7 +237,7 @@ proptest! {
         let np = m.positions_len();
         for c in 0..2 {
             for j in m.stored()[c]..m.elements {
-                y[np + m.zi(c, j)] = v * ((j as f64) * 0.7).sin();
+                y[np + m.z_index(c, j)] = v * ((j as f64) * 0.7).sin();
             }
         }
         y.extend_from_slice(&[0.0; 4]);

@@ -6,7 +6,7 @@
 
 use cdpr_core::model::{CableModel, SplitRule};
 use cdpr_core::scenario::Scenario;
-use cdpr_lumped::{E_OUT, Lumped, Params};
+use cdpr_lumped::{Lumped, Params, TOWARD_REEL};
 use proptest::prelude::*;
 
 /// Event functions per cable, in order: last stored node leaves, first free node is reeled in,
@@ -24,10 +24,10 @@ fn node_mass(s: &Scenario, n: usize) -> f64 {
 /// pulley, and every free node on the other.
 fn assert_stored_nodes_on_the_reel(m: &Lumped, y: &[f64]) -> Result<(), TestCaseError> {
     let np = m.positions_len();
-    for (cable, e_out) in E_OUT.into_iter().enumerate() {
+    for (cable, e_out) in TOWARD_REEL.into_iter().enumerate() {
         let r = m.stored()[cable];
         for j in 0..m.elements {
-            let (ix, iz) = (m.xi(cable, j), m.zi(cable, j));
+            let (ix, iz) = (m.x_index(cable, j), m.z_index(cable, j));
             let beyond = (y[ix] - m.pulley(cable).x) * e_out;
             if j < r {
                 prop_assert_eq!(y[iz], 0.0, "cable {}, stored node {}: z", cable, j);
@@ -81,8 +81,8 @@ fn moving_state(m: &mut Lumped, x: f64, tension_sum: f64, speed: f64, seed: u64)
     for cable in 0..2 {
         for j in m.stored()[cable]..m.elements {
             let phase = (seed as f64) * 0.37 + (cable * 97 + j) as f64;
-            y[np + m.xi(cable, j)] = speed * (1.3 * phase).sin();
-            y[np + m.zi(cable, j)] = speed * (0.7 * phase).cos();
+            y[np + m.x_index(cable, j)] = speed * (1.3 * phase).sin();
+            y[np + m.z_index(cable, j)] = speed * (0.7 * phase).cos();
         }
     }
     y
@@ -114,14 +114,14 @@ proptest! {
         let mut y = moving_state(&mut m, x, tension_sum, 0.05, seed);
         let np = m.positions_len();
         let r = m.stored()[cable];
-        let (ix, iz) = (m.xi(cable, r), m.zi(cable, r));
+        let (ix, iz) = (m.x_index(cable, r), m.z_index(cable, r));
         // The first free node at the pulley point, crossing onto the reel side.
         let pulley = (m.pulley(cable).x, 0.0);
         y[ix] = pulley.0;
         y[iz] = 0.0;
         y[np + iz] = vz;
-        let node = |j: usize| (y[m.xi(cable, j)], y[m.zi(cable, j)]);
-        let next = if r + 1 == elements { (y[m.xi(0, elements)], y[m.zi(0, elements)]) } else { node(r + 1) };
+        let node = |j: usize| (y[m.x_index(cable, j)], y[m.z_index(cable, j)]);
+        let next = if r + 1 == elements { (y[m.x_index(0, elements)], y[m.z_index(0, elements)]) } else { node(r + 1) };
         let tensions = spring_tension(&s, elements, pulley, node(r - 1), node(r), true)
             + spring_tension(&s, elements, pulley, node(r), next, false);
         let tolerance = 2.0 * cdpr_lumped::PULLEY_OFFSET * tensions + 1e-12;
@@ -166,17 +166,17 @@ proptest! {
             y[np..2 * np].fill(0.0);
             for c in 0..2 {
                 for j in 0..m.elements {
-                    y[np + m.xi(c, j)] = v;
+                    y[np + m.x_index(c, j)] = v;
                 }
             }
-            y[np + m.xi(0, m.elements)] = v;
+            y[np + m.x_index(0, m.elements)] = v;
         };
         translate(&m, &mut y);
         let kinetic = m.energy(&y).kinetic;
         prop_assert!((kinetic - expected).abs() <= 1e-12 * expected.max(1e-300), "{kinetic} vs {expected}");
         let r = m.stored()[cable];
-        y[m.xi(cable, r)] = m.pulley(cable).x;
-        y[m.zi(cable, r)] = 0.0;
+        y[m.x_index(cable, r)] = m.pulley(cable).x;
+        y[m.z_index(cable, r)] = 0.0;
         m.apply_event(PER_CABLE * cable + REELED_IN, 0.1, &mut y).unwrap();
         translate(&m, &mut y);
         let kinetic = m.energy(&y).kinetic;

@@ -124,7 +124,7 @@ impl<const D: usize> Lqr<D> {
     }
 
     /// ξ = (e, ė, σ).
-    fn xi(
+    fn design_state(
         &self,
         reference: &Reference<D>,
         effector: &Effector<D>,
@@ -180,7 +180,7 @@ impl<const D: usize> Controller<D> for Lqr<D> {
         let ff =
             tensions_for_acceleration(&self.robot, &reference.position, &reference.acceleration);
         let mut xi = [0.0; 3 * crate::robot::MAX_AXES];
-        self.xi(reference, effector, states, &mut xi);
+        self.design_state(reference, effector, states, &mut xi);
         let dt = self.feedback(&xi);
         let tensions = Tensions::from_fn(ff.len(), |i| ff[i] + dt[i]);
         let w = self.robot.structure_matrix(&effector.position);

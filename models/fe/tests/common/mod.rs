@@ -3,7 +3,7 @@
 //! and the generalised forces of the commanded tensions.
 
 #![allow(dead_code)]
-// Cable loops index several per-cable tables (E_OUT, pulleys, layout helpers) by the cable number.
+// Cable loops index several per-cable tables (TOWARD_REEL, pulleys, layout helpers) by the cable number.
 #![allow(clippy::needless_range_loop)]
 
 use cdpr_core::Vector2;
@@ -11,7 +11,7 @@ use cdpr_core::channel::Channel;
 use cdpr_core::model::{CableModel, SplitRule};
 use cdpr_core::robot::Tensions;
 use cdpr_core::scenario::Scenario;
-use cdpr_fe::{E_OUT, Fe, FeMass, FeStored, Params};
+use cdpr_fe::{Fe, FeMass, FeStored, Params, TOWARD_REEL};
 
 /// The FE model's parameters: `n` elements per span and the two variants.
 pub fn params(n: usize, mass: FeMass, stored: FeStored) -> Params {
@@ -115,7 +115,7 @@ pub fn kinetic(m: &Fe, y: &[f64]) -> f64 {
         }
         match m.rho_index(c) {
             Some(ri) => {
-                let e_out = Vector2::new(E_OUT[c], 0.0);
+                let e_out = Vector2::new(TOWARD_REEL[c], 0.0);
                 let (rho, rhod) = (y[ri], y[np + ri]);
                 let r = m.pulley(c) + e_out * rho;
                 t += element_kinetic(
