@@ -76,6 +76,14 @@ pub fn with_model<V: ModelVisitor>(
     scenario: &Scenario,
     visitor: V,
 ) -> Result<V::Output, BuildError> {
+    if let Some(anchors) = &scenario.robot.anchors {
+        return Err(cdpr_core::scenario::out_of_range(
+            "robot.anchors",
+            format!("{} anchors in space", anchors.len()),
+            "absent to build a cable model: the models are planar so far; a spatial robot's              statics are `cargo xtask distribution`",
+        )
+        .into());
+    }
     struct Build<'a, V>(&'a Scenario, V);
     impl<V: ModelVisitor> ParamsVisitor for Build<'_, V> {
         type Output = Result<V::Output, BuildError>;

@@ -7,6 +7,7 @@
 //! |---|---|---|
 //! | the paper on every model, checked against MODELS.md §8 | [`paper`] | `cargo xtask report` |
 //! | every controller on every model (the leaderboard) | [`control`] | `cargo xtask control` |
+//! | a spatial robot's tension distributions at a pose | [`distribution`] | `cargo xtask distribution` |
 //! | every input shaper on every model | [`shaping`] | `cargo xtask shaping` |
 //! | closed- and open-loop modes, the axial-damping sweep | [`modes`] | `cargo xtask modes` |
 //! | effector mass × move time grids | [`sweeps`] | part of the report |
@@ -15,6 +16,7 @@
 //! a study's output does not depend on the machine.
 
 pub mod control;
+pub mod distribution;
 pub mod modes;
 pub mod paper;
 pub mod pool;

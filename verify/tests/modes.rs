@@ -487,7 +487,7 @@ fn lumped_open_loop_drift_is_an_oscillation() {
     let eq = model
         .equilibrium(&SplitRule::new(0.5, s.controller.tension_sum))
         .unwrap();
-    let px = model.xi(0, model.elements);
+    let px = model.x_index(0, model.elements);
     let scale = 1e-6 / v[px].0.hypot(v[px].1);
     let mut y0 = lin.state.clone();
     for (yi, c) in y0.iter_mut().zip(v) {

@@ -11,6 +11,7 @@
 //! Errors are printed for a person and give a non-zero exit; a failed run keeps its output.
 
 mod control;
+mod distribution;
 mod figures;
 mod heatmap;
 mod modes;
@@ -135,6 +136,25 @@ enum Command {
         #[arg(long, default_value_t = 250)]
         tension_steps: usize,
     },
+    /// A spatial robot's statics at one pose: cable lengths, every tension distribution method
+    /// (MODELS.md §11) holding the effector's weight in the scenario's box [t_min, t_max], and
+    /// the largest uniform margin → DIR/distribution.json.
+    Distribution {
+        /// Scenario file with `[robot] anchors` (see examples/robots/).
+        #[arg(long)]
+        scenario: PathBuf,
+        /// Effector position X,Y,Z [m].
+        #[arg(
+            long,
+            value_delimiter = ',',
+            num_args = 1,
+            allow_negative_numbers = true
+        )]
+        at: Vec<f64>,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// A parameter study: every point of a grid file (a base scenario and axes over dotted
     /// scenario keys) run metrics-only on all cores → DIR/results.jsonl and DIR/results.csv.
     /// An interrupted sweep resumes; `--shard I/N` runs points i ≡ I (mod N) (a Slurm array
@@ -177,6 +197,7 @@ fn main() -> ExitCode {
         } => modes::run(scenario.as_deref(), controller, at, &out),
         Command::Control { scenario, out } => control::run(scenario.as_deref(), &out),
         Command::Shaping { scenario, out } => shaping::run_study(scenario.as_deref(), &out),
+        Command::Distribution { scenario, at, out } => distribution::run(&scenario, &at, &out),
         Command::Sweep {
             grid,
             out,

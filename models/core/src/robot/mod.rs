@@ -23,6 +23,7 @@
 //! ```
 
 pub mod cables;
+pub mod distribution;
 pub mod space;
 
 pub use cables::{CableId, MAX_CABLES, PerCable, Tensions};

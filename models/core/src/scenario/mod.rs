@@ -27,6 +27,10 @@ pub struct Robot {
     pub effector_mass: f64,
     /// Gravitational acceleration g [m/s²], acting along −z.
     pub gravity: f64,
+    /// A spatial robot's anchors [[x, y, z], …] [m] (MODELS.md §11: each cable's exit point from
+    /// its pulley, z up; 2 ≤ m ≤ 8). Absent: the planar robot of `anchor_distance`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub anchors: Option<Vec<Vec<f64>>>,
 }
 
 impl Default for Robot {
@@ -35,6 +39,7 @@ impl Default for Robot {
             anchor_distance: 1.0,
             effector_mass: 1.0,
             gravity: 9.81,
+            anchors: None,
         }
     }
 }
@@ -335,6 +340,19 @@ impl Scenario {
         ];
         crate::robot::Robot::new(&anchors, r.effector_mass, r.gravity)
             .expect("a validated scenario's robot")
+    }
+
+    /// The spatial robot of `[robot] anchors` (validated with the scenario); None for the planar
+    /// robot.
+    pub fn spatial_robot(&self) -> Option<crate::robot::Robot<3>> {
+        let anchors: Vec<crate::robot::Vector<3>> = self
+            .robot
+            .anchors
+            .as_ref()?
+            .iter()
+            .map(|a| crate::robot::Vector::<3>::from_iterator(a.iter().copied()))
+            .collect();
+        crate::robot::Robot::new(&anchors, self.robot.effector_mass, self.robot.gravity).ok()
     }
 
     /// Parses and validates a scenario from TOML text.
