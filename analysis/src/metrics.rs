@@ -243,9 +243,7 @@ pub struct Columns<'a> {
     pub x: &'a [f64],
     pub z: &'a [f64],
     pub err: &'a [f64],
-    pub t1: &'a [f64],
-    pub t2: &'a [f64],
-    /// Every cable's commanded tension, cable 1 first (`t1`, `t2` are the first two).
+    /// Every cable's commanded tension, cable 1 first.
     pub tensions: Vec<&'a [f64]>,
     pub e_residual: &'a [f64],
 }
@@ -260,8 +258,6 @@ impl<'a> Columns<'a> {
             x: col(Channel::X),
             z: col(Channel::Z),
             err: col(Channel::Error),
-            t1: col(Channel::T1),
-            t2: col(Channel::T2),
             tensions: (0..)
                 .map_while(|i| s.channel(Channel::Tension(CableId(i))))
                 .collect(),
@@ -381,7 +377,9 @@ impl Metrics {
     /// the controller's `context` (whose move end is the shaped reference's where one is shaped).
     pub fn from_run(run: &Run, step5: &Step5, dt: f64, context: &ControlContext) -> Self {
         let c = Columns::of(run);
-        let (t, x, z, err, t1, t2) = (c.t, c.x, c.z, c.err, c.t1, c.t2);
+        let (t, x, z, err) = (c.t, c.x, c.z, c.err);
+        let cable = |i: usize| c.tensions.get(i).copied().unwrap_or_default();
+        let (t1, t2) = (cable(0), cable(1));
         let t_end = t.last().copied().unwrap_or(0.0);
         let windows = Windows::new(context.move_start, context.move_end, t_end);
 

@@ -98,6 +98,26 @@ impl Channel {
             .collect()
     }
 
+    /// The names of [`Channel::cable_channels`] (a massive model's own channels).
+    pub fn cable_channel_names(cables: usize) -> Vec<String> {
+        Self::cable_channels(cables)
+            .into_iter()
+            .map(Channel::name)
+            .collect()
+    }
+
+    /// The units of [`Channel::cable_channels`], the stored cable counted in `stored_unit` (the
+    /// lumped model's "nodes", the FE model's "m").
+    pub fn cable_channel_units(cables: usize, stored_unit: &'static str) -> Vec<&'static str> {
+        Self::cable_channels(cables)
+            .into_iter()
+            .map(|c| match c {
+                Channel::Stored(_) => stored_unit,
+                c => c.unit(),
+            })
+            .collect()
+    }
+
     /// The column's name in the time series and its CSV heading.
     pub fn name(self) -> String {
         match self {

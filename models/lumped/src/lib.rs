@@ -444,21 +444,11 @@ impl CableModel<2> for Lumped {
     }
 
     fn channel_names(&self) -> Vec<String> {
-        cdpr_core::channel::Channel::cable_channels(2)
-            .into_iter()
-            .map(|c| c.name())
-            .collect()
+        cdpr_core::channel::Channel::cable_channel_names(2)
     }
 
     fn channel_units(&self) -> Vec<&'static str> {
-        use cdpr_core::channel::Channel;
-        Channel::cable_channels(2)
-            .into_iter()
-            .map(|c| match c {
-                Channel::Stored(_) => "nodes",
-                c => c.unit(),
-            })
-            .collect()
+        cdpr_core::channel::Channel::cable_channel_units(2, "nodes")
     }
 
     fn second_order(&self) -> Option<&dyn cdpr_core::second_order::SecondOrderForm> {

@@ -389,7 +389,7 @@ fn qp_result<const D: usize>(
 /// Every active set (each cable free, at t_min or at t_max; 3^m ≤ 6561): the free cables'
 /// tensions T_F = W_Fᵀλ with (W_F W_Fᵀ) λ = w − W_A T_A, accepted when T_F lies in the box and
 /// each fixed cable's u_iᵀλ lies beyond its bound (the KKT conditions). None accepted: no
-/// distribution exists; the minimum-norm solution clamped is returned, infeasible.
+/// distribution exists; the minimum-norm solution W⁺w is returned, infeasible.
 fn qp_by_enumeration<const D: usize>(
     w: &StructureMatrix<D>,
     wrench: &Vector<D>,
