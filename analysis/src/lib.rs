@@ -14,6 +14,7 @@ pub mod damping;
 pub mod linearise;
 pub mod metrics;
 pub mod modes;
+pub mod spatial;
 pub mod spectrum;
 
 use cdpr_core::model::ModelError;

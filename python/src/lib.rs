@@ -15,6 +15,7 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use registry::analysis::modes::Loop;
+use registry::core::runner::Observer;
 use registry::core::scenario::Scenario;
 use registry::{Assessed, Error, ModelKind};
 use serde_json::Value;
@@ -80,6 +81,7 @@ fn error(e: Error) -> PyErr {
         Error::Loop(e) => ScenarioError::new_err(e.to_string()),
         Error::Run(failure) => SimulationError::new_err(failure.to_string()),
         Error::Analysis(e) => SimulationError::new_err(e.to_string()),
+        Error::Reference(e) => ScenarioError::new_err(e.to_string()),
     }
 }
 
@@ -96,18 +98,30 @@ fn simulate<'py>(
     model: Option<&str>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
     let s = self::scenario(scenario, model)?;
-    let (assessed, map) = py
+    let (run, map) = py
         .detach(|| {
+            if s.robot.anchors.is_some() {
+                // A spatial robot: the metrics of `simulate`'s spatial metrics.json.
+                let done = registry::simulate_spatial(&s, &mut Observer::progress(&mut |_| {}))?;
+                let Value::Object(mut map) =
+                    serde_json::to_value(&done.metrics).expect("metrics serialise")
+                else {
+                    unreachable!("a struct serialises to an object")
+                };
+                map.insert("status".into(), "complete".into());
+                map.insert("t_reached".into(), Value::from(done.run.t_reached));
+                return Ok::<_, Error>((done.run, map));
+            }
             let assessed: Assessed = registry::assess(&s, &mut |_| {})?;
             let mut map = cdpr_sweep::metrics_map(&s, &assessed);
             map.insert("status".into(), "complete".into());
             map.insert("t_reached".into(), Value::from(assessed.run.t_reached));
-            Ok::<_, Error>((assessed, map))
+            Ok::<_, Error>((assessed.run, map))
         })
         .map_err(error)?;
     let metrics = to_py(py, &Value::Object(map))?;
     // The samples are stored column by column: each becomes a numpy array as it is.
-    let run = &assessed.run.series;
+    let run = &run.series;
     let columns: Vec<Vec<f64>> = (0..run.width())
         .map(|j| run.column_at(j).to_vec())
         .collect();

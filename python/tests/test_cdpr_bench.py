@@ -149,3 +149,21 @@ def test_dask_local_cluster_gets_the_cli_records(tmp_path):
     assert without_wall(tmp_path / "cli" / "results.jsonl") == without_wall(
         tmp_path / "dask" / "results.jsonl"
     )
+
+
+def test_a_spatial_robot_runs_as_the_cli_does(tmp_path):
+    scenario = ROOT / "examples" / "robots" / "hangprinter.toml"
+    cli("simulate", "--scenario", str(scenario), "--out", str(tmp_path / "out"))
+    theirs = json.loads((tmp_path / "out" / "metrics.json").read_text())
+    metrics, series = cdpr_bench.simulate(str(scenario))
+    assert metrics["cables"] == 4 and len(metrics["cable_tension_max"]) == 4
+    for key, value in metrics.items():
+        assert theirs[key] == value, key
+    assert metrics["path_err_max_move"] < 1e-6
+    with open(tmp_path / "out" / "timeseries.csv") as f:
+        rows = list(csv.reader(f))
+    names = [heading.split(" [")[0] for heading in rows[0]]
+    values = np.array(rows[1:], dtype=float)
+    assert {"x", "y", "z", "T4", "l0_4", "saturated"} <= set(series)
+    for k, name in enumerate(names):
+        assert np.array_equal(series[name], values[:, k]), name

@@ -80,7 +80,8 @@ pub fn with_model<V: ModelVisitor>(
         return Err(cdpr_core::scenario::out_of_range(
             "robot.anchors",
             format!("{} anchors in space", anchors.len()),
-            "absent to build a cable model: the models are planar so far; a spatial robot's              statics are `cargo xtask distribution`",
+            "absent for the planar studies: a spatial robot runs `cargo xtask simulate` (the \
+             elastic model, `simulate_spatial`), its statics `cargo xtask distribution`",
         )
         .into());
     }

@@ -43,6 +43,7 @@ mod config;
 mod kind;
 pub mod memory;
 mod provenance;
+mod spatial;
 mod study;
 
 pub use build::{BuildError, DynModel, ModelVisitor, build, with_model};
@@ -51,6 +52,10 @@ pub use config::{
 };
 pub use kind::ModelKind;
 pub use provenance::{Provenance, project_revision, revision};
+pub use spatial::{
+    FEASIBILITY_SAMPLES, InfeasibleReference, SpatialRun, check_reference, prepare_spatial,
+    simulate_spatial, spatial_metrics,
+};
 pub use study::{
     Assessed, EndAnalysis, Error, analyse, assess, assess_observed, assess_observed_into,
     damping_sweep, end_analysis, end_state, eq15_at_end, growth_resolution,

@@ -38,6 +38,9 @@ pub enum Error {
     Run(#[from] Box<RunFailure>),
     #[error(transparent)]
     Analysis(#[from] AnalysisError),
+    /// A spatial reference that no tensions in the box can follow.
+    #[error(transparent)]
+    Reference(#[from] crate::spatial::InfeasibleReference),
 }
 
 impl From<BuildError> for Error {

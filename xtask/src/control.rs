@@ -111,6 +111,7 @@ pub fn controller_color(kind: ControllerKind) -> RGBColor {
         ControllerKind::PidXz => RGBColor(255, 127, 14),
         ControllerKind::ComputedTorque => RGBColor(31, 119, 180),
         ControllerKind::Lqr => RGBColor(148, 103, 189),
+        ControllerKind::Length => RGBColor(44, 160, 44),
     }
 }
 

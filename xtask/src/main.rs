@@ -19,6 +19,8 @@ mod output;
 mod report;
 mod shaping;
 mod simulate;
+mod simulate_spatial;
+mod spatial_moves;
 mod statics_sweep;
 mod sweep;
 mod sweep_study;
@@ -136,6 +138,16 @@ enum Command {
         #[arg(long, default_value_t = 250)]
         tension_steps: usize,
     },
+    /// A spatial robot's move (`[trajectory] start`, `end`) under every controller and every
+    /// tension distribution → DIR/moves.json and DIR/moves.md (docs/spatial.md's table).
+    SpatialMoves {
+        /// Scenario file with `[robot] anchors` and a move (e.g. examples/robots/hangprinter.toml).
+        #[arg(long)]
+        scenario: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// A spatial robot's statics at one pose: cable lengths, every tension distribution method
     /// (MODELS.md §11) holding the effector's weight in the scenario's box [t_min, t_max], and
     /// the largest uniform margin → DIR/distribution.json.
@@ -198,6 +210,7 @@ fn main() -> ExitCode {
         Command::Control { scenario, out } => control::run(scenario.as_deref(), &out),
         Command::Shaping { scenario, out } => shaping::run_study(scenario.as_deref(), &out),
         Command::Distribution { scenario, at, out } => distribution::run(&scenario, &at, &out),
+        Command::SpatialMoves { scenario, out } => spatial_moves::run(&scenario, &out),
         Command::Sweep {
             grid,
             out,

@@ -25,13 +25,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Set by SIGINT/SIGTERM, or by a failed write of the samples: the run stops after its current
 /// step.
-static STOP: AtomicBool = AtomicBool::new(false);
+pub(crate) static STOP: AtomicBool = AtomicBool::new(false);
 
 /// The outputs of a run in `--out`; any of them left by an earlier run is removed first, so a
 /// failed run never sits beside another run's files.
-const TIMESERIES: &str = "timeseries.csv";
-const PARTIAL: &str = "timeseries.partial.csv";
-const METRICS: &str = "metrics.json";
+pub(crate) const TIMESERIES: &str = "timeseries.csv";
+pub(crate) const PARTIAL: &str = "timeseries.partial.csv";
+pub(crate) const METRICS: &str = "metrics.json";
 
 /// `metrics.json`: the run's status and provenance, the §7 metrics at the top level (absent when
 /// the run failed before its first sample), the units of every metric, and the modal analysis at
@@ -152,7 +152,7 @@ fn check_memory(scenario: &Scenario) -> Result<()> {
 
 /// The time series written as the run samples it, every `every`-th row. A failed write stops
 /// the run ([`STOP`]) and is reported with the file's path.
-struct CsvStream {
+pub(crate) struct CsvStream {
     writer: BufWriter<File>,
     path: PathBuf,
     every: usize,
@@ -161,7 +161,7 @@ struct CsvStream {
 }
 
 impl CsvStream {
-    fn create(path: PathBuf, headings: &[String], every: usize) -> Result<Self> {
+    pub(crate) fn create(path: PathBuf, headings: &[String], every: usize) -> Result<Self> {
         let file = File::create(&path).with_context(|| format!("creating {}", path.display()))?;
         let mut writer = BufWriter::with_capacity(1 << 16, file);
         writeln!(writer, "{}", headings.join(","))
@@ -175,7 +175,7 @@ impl CsvStream {
         })
     }
 
-    fn push(&mut self, row: &[f64]) {
+    pub(crate) fn push(&mut self, row: &[f64]) {
         if self.rows.is_multiple_of(self.every) && self.error.is_none() {
             let mut line = String::with_capacity(24 * row.len());
             csv_row(&mut line, row);
@@ -188,7 +188,7 @@ impl CsvStream {
     }
 
     /// The write error, as the run's reason.
-    fn failure(&self) -> Option<String> {
+    pub(crate) fn failure(&self) -> Option<String> {
         self.error
             .as_ref()
             .map(|e| format!("writing {}: {e}", self.path.display()))
@@ -196,7 +196,7 @@ impl CsvStream {
 
     /// Writes the rows the stream has not seen (those of a failing step), then renames the file
     /// into `target`. After a failed write the partial file stays as it is.
-    fn finish(
+    pub(crate) fn finish(
         mut self,
         series: &cdpr_bench::core::series::TimeSeries,
         target: &Path,
@@ -235,6 +235,9 @@ pub fn run(
     every: usize,
 ) -> Result<()> {
     let scenario = load_scenario(scenario, model)?;
+    if scenario.robot.anchors.is_some() {
+        return crate::simulate_spatial::run(&scenario, out, every);
+    }
     // What can be known before the run: refused here, before anything is written.
     let scenario = cdpr_bench::prepare(&scenario)?;
     let provenance = Provenance::of(&scenario)?;

@@ -25,6 +25,10 @@ pub enum Channel {
     Force,
     /// Commanded tension of a cable [N].
     Tension(CableId),
+    /// 1 where the tension limits clamped the controller's tensions by more than the
+    /// distribution's 1e-9 N tolerance, else 0 (spatial robots: the distribution found no
+    /// tensions in the box for the controller's wrench, or feedback left it).
+    Saturated,
     /// Kinetic energy [J].
     EKinetic,
     /// Elastic energy [J].
@@ -74,12 +78,15 @@ impl Channel {
 
     /// The channels every run of a D-dimensional robot with `cables` cables has, in order,
     /// before the model's own: t, x_ref, the effector's coordinates, the error, the force, T1 …
-    /// Tm (the plane: `t, x_ref, x, z, error, F, T1, T2`).
+    /// Tm, in space `saturated` (the plane: `t, x_ref, x, z, error, F, T1, T2`).
     pub fn common<const D: usize>(cables: usize) -> Vec<Channel> {
         let mut channels = vec![Channel::Time, Channel::XRef];
         channels.extend((0..D).map(Channel::axis::<D>));
         channels.extend([Channel::Error, Channel::Force]);
         channels.extend(CableId::all(cables).map(Channel::Tension));
+        if D == 3 {
+            channels.push(Channel::Saturated);
+        }
         channels
     }
 
@@ -129,6 +136,7 @@ impl Channel {
             Channel::Error => "error".into(),
             Channel::Force => "F".into(),
             Channel::Tension(c) => format!("T{c}"),
+            Channel::Saturated => "saturated".into(),
             Channel::EKinetic => "e_kinetic".into(),
             Channel::EElastic => "e_elastic".into(),
             Channel::EGravity => "e_gravity".into(),
@@ -161,7 +169,7 @@ impl Channel {
             | Channel::WReel
             | Channel::EDissipated
             | Channel::EResidual => "J",
-            Channel::Stored(_) => "",
+            Channel::Stored(_) | Channel::Saturated => "",
         }
     }
 

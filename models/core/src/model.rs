@@ -210,6 +210,41 @@ impl<const D: usize> RestRule<D> for SplitRule {
     }
 }
 
+/// A spatial robot at rest at a given pose (MODELS.md §11): every coordinate pinned, the
+/// tensions the controller's distribution commands there fixed (no parameter). A model's statics
+/// then only checks the balance (the massless cables) or finds its cables' shape.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoseRule<const D: usize> {
+    pinned: [(usize, f64); D],
+    pub tensions: Tensions,
+}
+
+impl<const D: usize> PoseRule<D> {
+    /// At rest at `pose` [m] under `tensions` [N].
+    pub fn new(pose: &crate::robot::Vector<D>, tensions: Tensions) -> Self {
+        Self {
+            pinned: std::array::from_fn(|k| (k, pose[k])),
+            tensions,
+        }
+    }
+}
+
+impl<const D: usize> RestRule<D> for PoseRule<D> {
+    fn pinned(&self) -> &[(usize, f64)] {
+        &self.pinned
+    }
+    fn tensions(&self, _: &[f64]) -> Tensions {
+        self.tensions
+    }
+    /// No parameter: never asked.
+    fn slope(&self, _: usize) -> Tensions {
+        Tensions::zeros(self.tensions.len())
+    }
+    fn scale(&self, _: usize) -> f64 {
+        1.0
+    }
+}
+
 /// Energy terms of a state [J]; gravity's zero is at z = 0 (the pulleys' height).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Energy {

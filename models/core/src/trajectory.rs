@@ -1,7 +1,9 @@
 //! The `step5` reference trajectory of the paper (eq. 13): a quintic that goes from x1 to x2 between
 //! t1 and t2 with zero velocity and acceleration at both ends, so the controller sees no shock.
 
+use crate::robot::Vector;
 use crate::scenario;
+use crate::shaper::Impulses;
 
 /// Quintic `step5` (paper eq. 13), with its first two derivatives for analysis and plots.
 ///
@@ -87,6 +89,112 @@ impl Step5 {
         let span = self.t2 - self.t1;
         let h = 3f64.sqrt() / 6.0;
         [self.t1 + (0.5 - h) * span, self.t1 + (0.5 + h) * span]
+    }
+}
+
+/// `step5` along a straight segment of a spatial robot: eq. 13 applied to the arc length, so
+/// p(t) = start + (end − start) σ(t), σ the quintic from 0 to 1 between t1 and t2. Velocity and
+/// acceleration are the segment's direction times σ̇, σ̈ (the feedforward of the controllers).
+///
+/// # Examples
+///
+/// ```
+/// use cdpr_core::robot::Vector;
+/// use cdpr_core::trajectory::Segment;
+///
+/// let move_ = Segment::<3> {
+///     start: Vector::<3>::zeros(),
+///     end: Vector::<3>::new(0.1, 0.05, 0.02),
+///     t1: 0.0,
+///     t2: 0.2,
+/// };
+/// assert_eq!(move_.position(0.2), move_.end);
+/// // The arc length's largest speed, 15 L / (8 T), at the middle of the move.
+/// let length = (move_.end - move_.start).norm();
+/// assert!((move_.velocity(0.1).norm() - 15.0 * length / (8.0 * 0.2)).abs() < 1e-12);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Segment<const D: usize> {
+    /// Start pose [m].
+    pub start: Vector<D>,
+    /// End pose [m].
+    pub end: Vector<D>,
+    /// Start time t1 [s].
+    pub t1: f64,
+    /// End time t2 [s] (> t1).
+    pub t2: f64,
+}
+
+impl<const D: usize> Segment<D> {
+    /// The quintic σ from 0 to 1 (eq. 13 with x1 = 0, x2 = 1).
+    fn unit(&self) -> Step5 {
+        Step5 {
+            x1: 0.0,
+            x2: 1.0,
+            t1: self.t1,
+            t2: self.t2,
+        }
+    }
+
+    /// p(t) [m].
+    pub fn position(&self, t: f64) -> Vector<D> {
+        self.at(self.unit().position(t))
+    }
+
+    /// The pose a fraction `sigma` of the way along the segment [m] (the start for 0, the end
+    /// for 1; a shaped reference convolves σ).
+    pub fn at(&self, sigma: f64) -> Vector<D> {
+        if sigma >= 1.0 {
+            return self.end;
+        }
+        self.start + (self.end - self.start) * sigma
+    }
+
+    /// ṗ(t) [m/s].
+    pub fn velocity(&self, t: f64) -> Vector<D> {
+        (self.end - self.start) * self.unit().velocity(t)
+    }
+
+    /// p̈(t) [m/s²].
+    pub fn acceleration(&self, t: f64) -> Vector<D> {
+        (self.end - self.start) * self.unit().acceleration(t)
+    }
+
+    /// The unit quintic σ(t), σ̇, σ̈ (for the shaper's convolution).
+    pub fn progress(&self) -> Step5 {
+        self.unit()
+    }
+
+    /// p_ref, ṗ_ref, p̈_ref at t [s]: σ convolved with `shaper`'s impulses (None or one unit
+    /// impulse: unshaped); ṗ and p̈ zero unless `derivatives`.
+    #[inline]
+    pub fn shaped(&self, shaper: Option<&Impulses>, t: f64, derivatives: bool) -> [Vector<D>; 3] {
+        let sigma = self.unit();
+        let convolve = |f: &dyn Fn(f64) -> f64| match shaper {
+            Some(shaper) if !shaper.is_none() => shaper.convolve(t, f),
+            _ => f(t),
+        };
+        let position = self.at(convolve(&|t| sigma.position(t)));
+        if !derivatives {
+            return [position, Vector::zeros(), Vector::zeros()];
+        }
+        let direction = self.end - self.start;
+        [
+            position,
+            direction * convolve(&|t| sigma.velocity(t)),
+            direction * convolve(&|t| sigma.acceleration(t)),
+        ]
+    }
+
+    /// Largest speed along the segment, 15 L / (8 (t2 − t1)) [m/s].
+    pub fn max_speed(&self) -> f64 {
+        15.0 * (self.end - self.start).norm() / (8.0 * (self.t2 - self.t1))
+    }
+
+    /// Largest |acceleration|, 10 L / (√3 (t2 − t1)²) [m/s²].
+    pub fn max_acceleration(&self) -> f64 {
+        let span = self.t2 - self.t1;
+        10.0 * (self.end - self.start).norm() / (3f64.sqrt() * span * span)
     }
 }
 

@@ -86,6 +86,44 @@ impl<const D: usize> Elastic<D> {
     }
 }
 
+impl<const D: usize> Elastic<D> {
+    /// A rule that pins every coordinate (a spatial robot at rest at a pose, tensions given):
+    /// nothing to solve, the balance is checked — to 1e-9 of the weight plus the tensions, the
+    /// tension distribution's W T = w holding to 1e-12 of the wrench.
+    fn balance_at_pose(&self, rule: &dyn RestRule<D>) -> Result<Equilibrium, ModelError> {
+        let mut p = Vector::<D>::zeros();
+        for &(axis, value) in rule.pinned() {
+            p[axis] = value;
+        }
+        let tensions = rule.tensions(&[]);
+        let residual = self.net_force(&p, &tensions).amax();
+        let r = &self.robot;
+        let scale = r.effector_mass * r.gravity + tensions.iter().map(|t| t.abs()).sum::<f64>();
+        if residual.is_nan() || residual > 1e-9 * scale {
+            return Err(ModelError::Parameter {
+                name: "rest tensions",
+                value: residual,
+                allowed: format!(
+                    "a net force ≤ {:e} N at {:?} m: the tensions {:?} N do not hold the \
+                     effector there (no distribution in the box holds its weight)",
+                    1e-9 * scale,
+                    p.as_slice(),
+                    tensions
+                ),
+            });
+        }
+        let mut state = vec![0.0; 2 * D];
+        state[..D].copy_from_slice(p.as_slice());
+        Ok(Equilibrium {
+            state,
+            tensions,
+            parameters: Vec::new(),
+            iterations: 0,
+            residual,
+        })
+    }
+}
+
 impl Elastic<2> {
     /// The planar robot of `scenario` (its `[robot]` and `[cable]` sections).
     pub fn from_scenario(scenario: &Scenario) -> Self {
@@ -180,6 +218,9 @@ impl<const D: usize> CableModel<D> for Elastic<D> {
 
     fn equilibrium(&mut self, rule: &dyn RestRule<D>) -> Result<Equilibrium, ModelError> {
         let pinned = rule.pinned();
+        if pinned.len() == D {
+            return self.balance_at_pose(rule);
+        }
         let free: Vec<usize> = (0..D)
             .filter(|k| pinned.iter().all(|(axis, _)| axis != k))
             .collect();

@@ -10,15 +10,16 @@
 
 mod implicit;
 mod rest;
+mod spatial;
 
 pub use rest::LoopError;
 
 use crate::controller::{self, AnyController, Controller, Reference, TensionLimits};
 use crate::model::CableModel;
 use crate::robot::{Effector, Robot, Tensions, Vector};
-use crate::scenario::Scenario;
+use crate::scenario::{ControllerKind, Scenario};
 use crate::shaper::Impulses;
-use crate::trajectory::Step5;
+use crate::trajectory::{Segment, Step5};
 use cdpr_numerics::OdeSystem;
 
 /// Where the commanded tensions come from.
@@ -61,6 +62,9 @@ pub struct ClosedLoop<M: CableModel<D>, const D: usize> {
     /// the scenario's shaper design is still "auto" (the runner refuses to run then).
     pub shaper: Option<Impulses>,
     pub controller: AnyController<D>,
+    /// A spatial robot's move (`trajectory.start` → `end`); None: the plane's x1 → x2 with
+    /// the other coordinates held.
+    pub path: Option<Segment<D>>,
     pub limits: TensionLimits,
     pub actuation: Actuation,
     /// ΣT of the start equilibrium (MODELS.md §2) [N].
@@ -92,12 +96,22 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         }
         let feedforward = controller.uses_reference_derivatives();
         let m = model.cables();
+        let path = spatial::path(scenario, m);
         Ok(Self {
             model,
             trajectory: Step5::from(&scenario.trajectory),
             shaper: scenario.trajectory.impulses().ok().flatten(),
             controller,
-            limits: TensionLimits::from(&scenario.controller),
+            path,
+            // Reels driven by length: the cables pull with what their strain gives.
+            limits: if scenario.controller.kind == ControllerKind::Length {
+                TensionLimits {
+                    t_min: f64::NEG_INFINITY,
+                    t_max: f64::INFINITY,
+                }
+            } else {
+                TensionLimits::from(&scenario.controller)
+            },
             actuation: Actuation::Controller,
             tension_sum: scenario.controller.tension_sum,
             hold: None,
@@ -134,6 +148,9 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
     /// not read them.
     #[inline]
     pub fn reference(&self, t: f64) -> Reference<D> {
+        if let Some(path) = &self.path {
+            return self.path_reference(path, t);
+        }
         let step = &self.trajectory;
         let (x, v, a) = match &self.shaper {
             Some(shaper) if !shaper.is_none() => {
@@ -179,6 +196,29 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         let effector = self.model.effector(&y[..n]);
         let states = &y[n..n + self.controller_len()];
         self.command_with(t, &self.reference(t), &effector, states)
+    }
+
+    /// Whether a cable may go slack (zero tension) without failing the run: reels driven by
+    /// length, whose cables pull only with their strain.
+    pub fn slack_allowed(&self) -> bool {
+        self.controller.kind() == ControllerKind::Length
+    }
+
+    /// How far the controller's tensions at (t, y) lie outside the limits before the clamp [N]
+    /// (≤ 0: inside). A spatial run's `saturated` channel counts a clamp beyond the
+    /// distribution's [`BOX_TOLERANCE`](crate::robot::distribution::BOX_TOLERANCE), not the
+    /// round-off of a cable the distribution put on a bound.
+    pub fn clamp_excess(&self, t: f64, y: &[f64]) -> f64 {
+        let n = self.model_len();
+        let effector = self.model.effector(&y[..n]);
+        let states = &y[n..n + self.controller_len()];
+        let out = self
+            .controller
+            .output(&self.reference(t), &effector, states);
+        out.tensions
+            .iter()
+            .map(|&t| (self.limits.t_min - t).max(t - self.limits.t_max))
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// The command for a given reference, effector and controller states.

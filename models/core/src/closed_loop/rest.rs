@@ -39,6 +39,9 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
     /// holding the equilibrium's tensions (the paper's PID: w(0) = F0/I, f(0) = e(0) = 0), audits
     /// zero. The equilibrium's position becomes the held start of the reference.
     pub fn initial_state(&mut self) -> Result<(Vec<f64>, Equilibrium), LoopError> {
+        if let Some(path) = self.path {
+            return self.start_of_path(&path);
+        }
         let x = self.trajectory.position(0.0);
         let eq = self
             .model
@@ -122,13 +125,20 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
     /// `[equilibrium state | controller states holding its tensions | 0 | 0]`.
     fn assemble(&mut self, x: f64, eq: &Equilibrium) -> Vec<f64> {
         let effector = self.model.effector(&eq.state);
-        self.rest_tensions = eq.tensions;
         let mut position = self.hold.unwrap_or(effector.position);
         position[0] = x;
         let reference = Reference {
             position,
             ..Reference::default()
         };
+        self.assemble_at(&reference, eq)
+    }
+
+    /// As [`ClosedLoop::assemble`], the controller at rest on `reference`.
+    pub(super) fn assemble_at(&mut self, reference: &Reference<D>, eq: &Equilibrium) -> Vec<f64> {
+        let effector = self.model.effector(&eq.state);
+        self.rest_tensions = eq.tensions;
+        let reference = *reference;
         let rest = Rest {
             tensions: eq.tensions,
             force: eq.parameters.first().copied().unwrap_or(0.0),

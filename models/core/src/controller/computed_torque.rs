@@ -12,6 +12,7 @@
 //! ∫e per axis, then the filter's two per axis). Anti-windup: the integrals hold while the
 //! command is clamped.
 
+use super::distribution::TensionSolver;
 use super::error_states::{self, ErrorStates};
 use super::velocity_filter::VelocityFilter;
 use super::{Controller, Measures, Output, Reference, Rest, StepStart};
@@ -30,6 +31,8 @@ pub struct ComputedTorque<const D: usize> {
     /// The integral and filtered-velocity error states.
     pub errors: ErrorStates,
     pub robot: Robot<D>,
+    /// W T = f: directly, or by the distribution of a redundant robot.
+    pub solver: TensionSolver,
 }
 
 impl<const D: usize> ComputedTorque<D> {
@@ -44,6 +47,7 @@ impl<const D: usize> ComputedTorque<D> {
                 },
             },
             robot,
+            solver: TensionSolver::from(c),
         }
     }
 
@@ -86,7 +90,9 @@ impl<const D: usize> Controller<D> for ComputedTorque<D> {
         let a = self.acceleration(reference, effector, states);
         Output {
             wrench: self.robot.effector_mass * a,
-            tensions: super::tensions_for_acceleration(&self.robot, &effector.position, &a),
+            tensions: self
+                .solver
+                .for_acceleration(&self.robot, &effector.position, &a),
         }
     }
     fn state_rate(

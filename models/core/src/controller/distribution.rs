@@ -3,7 +3,8 @@
 //! structure matrix that maps tensions to the force for any desired force is the robot's:
 //! [`crate::robot::Robot::structure_matrix`].)
 
-use crate::robot::Tensions;
+use crate::robot::distribution::{DistributionMethod, TensionBox, distribute};
+use crate::robot::{Robot, Tensions, Vector, vertical};
 use crate::scenario;
 
 /// The closed-form split of two opposed cables' tensions (paper §3.2, MODELS.md §2): the
@@ -79,5 +80,62 @@ impl TensionLimits {
     pub fn clamp(&self, tensions: &Tensions) -> (Tensions, bool) {
         let clamped = tensions.map(|t| t.clamp(self.t_min, self.t_max));
         (clamped, clamped != *tensions)
+    }
+}
+
+/// How a controller's force on the effector becomes m tensions (MODELS.md §11): W T = f solved
+/// directly for a robot with as many cables as axes (the plane's 2 × 2 by its closed form), by
+/// the scenario's distribution in the box [t_min, t_max] for a redundant robot. A distribution
+/// that finds no tensions in the box still returns its best (the limits then clamp it and the
+/// run counts the saturated time); a degenerate W gives NaN, which the runner refuses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TensionSolver {
+    pub method: DistributionMethod,
+    pub limits: TensionBox,
+}
+
+impl From<&scenario::Controller> for TensionSolver {
+    fn from(c: &scenario::Controller) -> Self {
+        Self {
+            method: c.distribution,
+            limits: TensionBox {
+                t_min: c.t_min.unwrap_or(0.0),
+                t_max: c.t_max.unwrap_or(f64::INFINITY),
+            },
+        }
+    }
+}
+
+impl TensionSolver {
+    /// Tensions T with W(p) T = `force` [N].
+    #[inline]
+    pub fn for_force<const D: usize>(
+        &self,
+        robot: &Robot<D>,
+        p: &Vector<D>,
+        force: &Vector<D>,
+    ) -> Tensions {
+        if let Some(t) = robot.tensions_for_force(p, force) {
+            return t;
+        }
+        distribute(self.method, &robot.structure_matrix(p), force, self.limits).map_or_else(
+            |_| Tensions::from_fn(robot.cables(), |_| f64::NAN),
+            |d| d.tensions,
+        )
+    }
+
+    /// Tensions that give the effector at `p` the acceleration `a` [m/s²] on rigid massless
+    /// cables: W T = M (a − g⃗).
+    #[inline]
+    pub fn for_acceleration<const D: usize>(
+        &self,
+        robot: &Robot<D>,
+        p: &Vector<D>,
+        a: &Vector<D>,
+    ) -> Tensions {
+        let v = vertical::<D>();
+        let mut lift = *a;
+        lift[v] = a[v] + robot.gravity;
+        self.for_force(robot, p, &(lift * robot.effector_mass))
     }
 }

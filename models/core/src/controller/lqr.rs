@@ -8,7 +8,7 @@
 //! ```
 //!
 //! W* and G* = −Σ T_i (I − u_i u_iᵀ)/l_i are the structure matrix and geometric stiffness at the
-//! design point, T* = W*⁻¹ (0, M g). In the loop the deviation is taken from the reference, and
+//! design point, T* = W*⁻¹ (0, M g) (a redundant robot's: its distribution of M g). In the loop the deviation is taken from the reference, and
 //! the tensions that hold the reference on rigid cables are fed forward:
 //! T = W(p_ref)⁻¹ M (a_ref − g) + K (e, ė, ∫e),  e = p_ref − p. Q = diag(q_position I,
 //! q_velocity I, q_integral I), R = r I. The velocity error is measured through
@@ -16,12 +16,10 @@
 //! poles). Anti-windup: the integrals hold while the command is clamped. The design needs as many
 //! cables as axes (W* square); a redundant robot's LQR designs through its tension distribution.
 
+use super::distribution::TensionSolver;
 use super::error_states::{self, ErrorStates};
 use super::velocity_filter::VelocityFilter;
-use super::{
-    ControlError, Controller, Measures, Output, Reference, Rest, StepStart,
-    tensions_for_acceleration,
-};
+use super::{ControlError, Controller, Measures, Output, Reference, Rest, StepStart};
 use crate::robot::{Effector, Matrix, Robot, Tensions, Vector, vertical};
 use crate::scenario::{ControllerKind, Scenario};
 
@@ -37,6 +35,10 @@ pub struct Lqr<const D: usize> {
     pub robot: Robot<D>,
     /// The integral and filtered-velocity error states.
     pub errors: ErrorStates,
+    /// The feedforward's W T = M (a − g⃗): directly, or by the distribution of a redundant
+    /// robot (whose feedback K ξ then lies in the range of Wᵀ, leaving the internal force to
+    /// the distribution).
+    pub solver: TensionSolver,
     weights: [f64; 4],
 }
 
@@ -51,6 +53,10 @@ impl<const D: usize> Lqr<D> {
         let mut design_point = Vector::zeros();
         design_point[0] = scenario.trajectory.x2;
         design_point[vertical::<D>()] = f64::NAN;
+        // A spatial move's end pose (its height set again by `hold_height`).
+        if let (Some(end), 3) = (&scenario.trajectory.end, D) {
+            design_point = Vector::from_iterator(end.iter().copied());
+        }
         Self {
             gain: vec![0.0; robot.cables() * Self::DESIGN_STATES],
             design_point,
@@ -61,6 +67,7 @@ impl<const D: usize> Lqr<D> {
                     omega: c.velocity_filter,
                 },
             },
+            solver: TensionSolver::from(c),
             weights: [c.q_position, c.q_velocity, c.q_integral, c.r],
         }
     }
@@ -77,7 +84,7 @@ impl<const D: usize> Lqr<D> {
         let pd = self.design_point;
         let (n, m) = (Self::DESIGN_STATES, r.cables());
         let w = r.structure_matrix(&pd);
-        let hold = tensions_for_acceleration(r, &pd, &Vector::zeros());
+        let hold = self.solver.for_acceleration(r, &pd, &Vector::zeros());
         let g: Matrix<D> = r.geometric_stiffness(&pd, &hold) / r.effector_mass;
         let mut a = vec![0.0; n * n];
         let mut b = vec![0.0; n * m];
@@ -101,9 +108,9 @@ impl<const D: usize> Lqr<D> {
             point: self.design_point.iter().copied().collect(),
             why,
         };
-        if m != D {
+        if m < D {
             return Err(error(format!(
-                "{m} cables on {D} axes: this design needs as many cables as axes"
+                "{m} cables on {D} axes: the design needs at least as many cables as axes"
             )));
         }
         let (a, b) = self.linearisation();
@@ -178,16 +185,25 @@ impl<const D: usize> Controller<D> for Lqr<D> {
         states: &[f64],
     ) -> Output<D> {
         let ff =
-            tensions_for_acceleration(&self.robot, &reference.position, &reference.acceleration);
+            self.solver
+                .for_acceleration(&self.robot, &reference.position, &reference.acceleration);
         let mut xi = [0.0; 3 * crate::robot::MAX_AXES];
         self.design_state(reference, effector, states, &mut xi);
         let dt = self.feedback(&xi);
         let tensions = Tensions::from_fn(ff.len(), |i| ff[i] + dt[i]);
         let w = self.robot.structure_matrix(&effector.position);
-        Output {
-            wrench: w.force(&tensions),
-            tensions,
+        let wrench = w.force(&tensions);
+        if self.robot.cables() > D {
+            // A redundant robot: the same wrench, distributed again so that the feedback keeps
+            // the box (K ξ alone would push a cable the distribution put on a bound past it).
+            return Output {
+                wrench,
+                tensions: self
+                    .solver
+                    .for_force(&self.robot, &effector.position, &wrench),
+            };
         }
+        Output { wrench, tensions }
     }
     fn state_rate(
         &self,
@@ -213,7 +229,9 @@ impl<const D: usize> Controller<D> for Lqr<D> {
     }
     fn rest_states(&self, reference: &Reference<D>, _: &Effector<D>, rest: &Rest, out: &mut [f64]) {
         // K_σ σ = T_rest − T_ff at zero error.
-        let ff = tensions_for_acceleration(&self.robot, &reference.position, &Vector::zeros());
+        let ff = self
+            .solver
+            .for_acceleration(&self.robot, &reference.position, &Vector::zeros());
         let n = Self::DESIGN_STATES;
         let sigma = if self.robot.cables() == D {
             let k_sigma = Matrix::<D>::from_fn(|i, j| self.gain[i * n + 2 * D + j]);

@@ -46,16 +46,21 @@
 //! | `pid-xz` | [`pid_xz`] | x and z through W | w_x, f_x, w_z, f_z |
 //! | `computed-torque` | [`computed_torque`] | x and z, feedback-linearised | ∫e_x, ∫e_z, velocity filter (4) |
 //! | `lqr` | [`lqr`] | x and z, state feedback | ∫e_x, ∫e_z, velocity filter (4) |
+//! | `length` (spatial robots) | [`length`] | the reels' unstrained lengths, no feedback | none |
+//!
+//! On a spatial robot every kind acts on x, y and z (three filters more), and a redundant robot's
+//! wrench becomes tensions by the scenario's distribution ([`TensionSolver`]).
 
 pub mod computed_torque;
 pub mod distribution;
 pub mod error_states;
+pub mod length;
 pub mod lqr;
 pub mod pid;
 pub mod pid_xz;
 pub mod velocity_filter;
 
-pub use distribution::{TensionDistribution, TensionLimits, split_tensions};
+pub use distribution::{TensionDistribution, TensionLimits, TensionSolver, split_tensions};
 pub use pid::{PaperPid, Pid, PidState};
 
 use crate::robot::{Effector, Robot, Tensions, Vector, along_vertical};
@@ -229,12 +234,19 @@ pub fn acceleration<const D: usize>(
 pub fn build<const D: usize>(scenario: &Scenario, robot: Robot<D>) -> AnyController<D> {
     let c = &scenario.controller;
     match c.kind {
+        // A spatial robot of three or more cables: the paper's gains on every axis.
+        ControllerKind::Pid if robot.cables() > 2 => {
+            AnyController::PidXz(pid_xz::PidXz::paper_gains_per_axis(c, robot))
+        }
         ControllerKind::Pid => AnyController::Pid(PaperPid::from(c)),
         ControllerKind::PidXz => AnyController::PidXz(pid_xz::PidXz::new(c, robot)),
         ControllerKind::ComputedTorque => {
             AnyController::ComputedTorque(computed_torque::ComputedTorque::new(c, robot))
         }
         ControllerKind::Lqr => AnyController::Lqr(lqr::Lqr::new(scenario, robot)),
+        ControllerKind::Length => {
+            AnyController::Length(length::LengthControl::new(scenario, robot))
+        }
     }
 }
 
@@ -247,6 +259,7 @@ pub enum AnyController<const D: usize> {
     PidXz(pid_xz::PidXz<D>),
     ComputedTorque(computed_torque::ComputedTorque<D>),
     Lqr(lqr::Lqr<D>),
+    Length(length::LengthControl<D>),
 }
 
 /// `$body` with `$c` bound to the controller inside `$self`, whichever it is.
@@ -257,6 +270,7 @@ macro_rules! dispatch {
             AnyController::PidXz($c) => $body,
             AnyController::ComputedTorque($c) => $body,
             AnyController::Lqr($c) => $body,
+            AnyController::Length($c) => $body,
         }
     };
 }

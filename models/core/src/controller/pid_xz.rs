@@ -10,8 +10,9 @@
 //! integration: while the command is clamped to [t_min, t_max], the integrals hold. In space the
 //! y axis takes the x gains.
 
+use super::distribution::TensionSolver;
 use super::{Controller, Measures, Output, Pid, PidState, Reference, Rest, StepStart};
-use crate::robot::{Effector, Robot, Tensions, Vector, along_vertical, vertical};
+use crate::robot::{Effector, Robot, Vector, along_vertical, vertical};
 use crate::scenario::{self, ControllerKind};
 
 /// One PID per axis (x and, in space, y with the x gains; z with its own), decoupled through W.
@@ -19,6 +20,11 @@ use crate::scenario::{self, ControllerKind};
 pub struct PidXz<const D: usize> {
     pub axes: [Pid; D],
     pub robot: Robot<D>,
+    /// W T = f: directly, or by the distribution of a redundant robot.
+    pub solver: TensionSolver,
+    /// `pid-xz`, or `pid` on a spatial robot with three or more cables (the paper's gains on
+    /// every axis, gravity held by the distribution).
+    kind: ControllerKind,
 }
 
 impl<const D: usize> PidXz<D> {
@@ -39,6 +45,18 @@ impl<const D: usize> PidXz<D> {
                 }
             }),
             robot,
+            solver: TensionSolver::from(c),
+            kind: ControllerKind::PidXz,
+        }
+    }
+
+    /// `pid` on a spatial robot: the paper's gains (p, i, d, filter) on every axis, the weight
+    /// fed forward through the tension distribution.
+    pub fn paper_gains_per_axis(c: &scenario::Controller, robot: Robot<D>) -> Self {
+        Self {
+            axes: [Pid::from(c); D],
+            kind: ControllerKind::Pid,
+            ..Self::new(c, robot)
         }
     }
 
@@ -58,7 +76,7 @@ fn state(states: &[f64], k: usize) -> PidState {
 
 impl<const D: usize> Controller<D> for PidXz<D> {
     fn kind(&self) -> ControllerKind {
-        ControllerKind::PidXz
+        self.kind
     }
     fn state_len(&self) -> usize {
         2 * D
@@ -81,9 +99,8 @@ impl<const D: usize> Controller<D> for PidXz<D> {
         Output {
             wrench: force,
             tensions: self
-                .robot
-                .tensions_for_force(&effector.position, &pull)
-                .unwrap_or_else(|| Tensions::from_fn(self.robot.cables(), |_| f64::NAN)),
+                .solver
+                .for_force(&self.robot, &effector.position, &pull),
         }
     }
     fn state_rate(

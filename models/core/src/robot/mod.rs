@@ -230,7 +230,8 @@ impl<const D: usize> Robot<D> {
     }
 
     /// Whether `p` lies in the workspace: below the highest anchor and, seen from above, inside
-    /// the anchors' convex hull (the plane: strictly between the pulleys and below them).
+    /// the anchors' convex hull (the plane, and two cables in space: strictly between the
+    /// pulleys and below them).
     pub fn in_workspace(&self, p: &Vector<D>) -> bool {
         let top = self
             .anchors()
@@ -239,6 +240,13 @@ impl<const D: usize> Robot<D> {
             .fold(f64::NEG_INFINITY, f64::max);
         if height(p) >= top || height(p).is_nan() {
             return false;
+        }
+        if D == 3 && self.cables == 2 {
+            // Two cables in space (the paper's robot in a vertical plane): strictly between
+            // the anchors along their line.
+            let (a, b) = (self.anchors[0], self.anchors[1]);
+            let s = (p - a).dot(&(b - a)) / (b - a).norm_squared();
+            return s > 0.0 && s < 1.0;
         }
         match D {
             2 => {

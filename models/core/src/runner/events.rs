@@ -85,10 +85,18 @@ impl EventMonitor {
     }
 }
 
-/// A commanded tension ≤ 0 (or NaN) is a slack cable (the first such cable is named).
+/// A commanded tension ≤ 0 (or NaN) is a slack cable (the first such cable is named): a
+/// tension-controlled winch cannot command it. Reels driven by length (`slack_allowed`) leave a
+/// cable slack at zero tension, which is physics, not a failure; a negative or NaN tension still
+/// is.
 #[inline]
-pub(super) fn check_slack(t: f64, tensions: &Tensions) -> Result<(), RunError> {
-    match tensions.iter().position(|&t| t <= 0.0 || t.is_nan()) {
+pub(super) fn check_slack(
+    t: f64,
+    tensions: &Tensions,
+    slack_allowed: bool,
+) -> Result<(), RunError> {
+    let slack = |t: f64| t < 0.0 || (t == 0.0 && !slack_allowed) || t.is_nan();
+    match tensions.iter().position(|&t| slack(t)) {
         None => Ok(()),
         Some(i) => Err(RunError::SlackCable {
             t,

@@ -373,7 +373,11 @@ fn integrate<M: CableModel<D>, const D: usize>(
             let t = stepper.time();
             sampler.sample_through(sys, stepper, t)?;
             observer.emit(&sampler.series, taken, &mut row);
-            check_slack(t, &sys.command(t, stepper.state()).tensions)?;
+            check_slack(
+                t,
+                &sys.command(t, stepper.state()).tensions,
+                sys.slack_allowed(),
+            )?;
             monitor.accept(sys, stepper.state());
             (observer.progress)(t / t_end);
             continue;
@@ -389,7 +393,11 @@ fn integrate<M: CableModel<D>, const D: usize>(
         sampler.event_energy += event.energy_change;
         events.push(event);
         stepper.restart(sys, t_event, &y);
-        check_slack(t_event, &sys.command(t_event, &y).tensions)?;
+        check_slack(
+            t_event,
+            &sys.command(t_event, &y).tensions,
+            sys.slack_allowed(),
+        )?;
         monitor.accept(sys, &y);
     }
     Ok(())

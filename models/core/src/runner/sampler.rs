@@ -53,7 +53,7 @@ impl Sampler {
             }
             let y = &self.y;
             let cmd = sys.command(tk, y);
-            check_slack(tk, &cmd.tensions)?;
+            check_slack(tk, &cmd.tensions, sys.slack_allowed())?;
             let model_state = &y[..n];
             let eff = sys.model.effector(model_state);
             if !sys.robot().in_workspace(&eff.position) {
@@ -68,15 +68,21 @@ impl Sampler {
             let residual = energy.total() - self.energy0 - work + dissipated - self.event_energy;
             let m = self.model_channels;
             let cables = cmd.tensions.len();
+            let flag = usize::from(D == 3);
+            let saturated =
+                flag == 1 && sys.clamp_excess(tk, y) > crate::robot::distribution::BOX_TOLERANCE;
             self.series.push_row_with(|row| {
-                let (common, rest) = row.split_at_mut(4 + D + cables);
+                let (common, rest) = row.split_at_mut(4 + D + cables + flag);
                 let (own, energies) = rest.split_at_mut(m);
                 common[0] = tk;
                 common[1] = cmd.reference;
                 common[2..2 + D].copy_from_slice(eff.position.as_slice());
                 common[2 + D] = cmd.error;
                 common[3 + D] = cmd.force;
-                common[4 + D..].copy_from_slice(&cmd.tensions);
+                common[4 + D..4 + D + cables].copy_from_slice(&cmd.tensions);
+                if flag == 1 {
+                    common[4 + D + cables] = f64::from(u8::from(saturated));
+                }
                 sys.model.channels(model_state, &cmd.tensions, own);
                 energies.copy_from_slice(&[
                     energy.kinetic,

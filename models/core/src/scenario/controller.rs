@@ -4,6 +4,7 @@
 //! others' keys (see [`crate::controller`] for the equations).
 
 use super::{Robot, ScenarioError, finite, non_negative, out_of_range, positive};
+use crate::robot::distribution::DistributionMethod;
 use serde::Deserialize;
 
 /// The controller that computes the commanded tensions.
@@ -20,10 +21,27 @@ pub enum ControllerKind {
     ComputedTorque,
     /// Linear-quadratic state feedback with integral action, designed on the elastic loop.
     Lqr,
+    /// The reels follow unstrained lengths with a flex compensation, as printer firmware does
+    /// (spatial robots).
+    Length,
+}
+
+/// How the `length` controller stretches the reference's cable lengths (MODELS.md §11).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize, serde::Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+pub enum FlexCompensation {
+    /// By the distribution of the static load M g at p_ref(t) (the firmware's).
+    #[default]
+    Static,
+    /// By the distribution of M (a_ref − g⃗).
+    Dynamic,
+    /// Not at all: the start pose's lengths shifted by the geometric length change.
+    None,
 }
 
 impl ControllerKind {
-    /// Every controller, in the leaderboard's order.
+    /// Every tension controller, in the leaderboard's order (the planar robot's controllers).
     pub const ALL: [ControllerKind; 4] = [
         ControllerKind::Pid,
         ControllerKind::PidXz,
@@ -38,6 +56,7 @@ impl ControllerKind {
             ControllerKind::PidXz => "pid-xz",
             ControllerKind::ComputedTorque => "computed-torque",
             ControllerKind::Lqr => "lqr",
+            ControllerKind::Length => "length",
         }
     }
 
@@ -90,6 +109,22 @@ pub struct Controller {
     pub q_integral: f64,
     /// `lqr`: weight of the tension deviation [1/N²].
     pub r: f64,
+    /// How a redundantly actuated robot (more cables than axes) turns the controller's wrench
+    /// into tensions in the box [t_min, t_max] (MODELS.md §11). Robots with as many cables as
+    /// axes solve W T = w directly and ignore it.
+    #[serde(skip_serializing_if = "is_qp")]
+    pub distribution: DistributionMethod,
+    /// `length`: how the reels' lengths allow for the cables' stretch.
+    #[serde(skip_serializing_if = "is_static")]
+    pub flex_compensation: FlexCompensation,
+}
+
+fn is_static(flex: &FlexCompensation) -> bool {
+    *flex == FlexCompensation::Static
+}
+
+fn is_qp(method: &DistributionMethod) -> bool {
+    *method == DistributionMethod::Qp
 }
 
 impl Default for Controller {
@@ -120,6 +155,8 @@ impl Default for Controller {
             q_velocity: 1e4,
             q_integral: 1e10,
             r: 1.0,
+            distribution: DistributionMethod::Qp,
+            flex_compensation: FlexCompensation::Static,
         }
     }
 }
@@ -128,6 +165,12 @@ impl Controller {
     /// Checks the gains of the chosen kind and the limits against the pretension and the
     /// effector's weight.
     pub(super) fn validate(&self, robot: &Robot) -> Result<(), ScenarioError> {
+        self.validate_gains()?;
+        self.validate_limits(robot)
+    }
+
+    /// The chosen kind's gains (and the paper's pretension, which every start uses).
+    pub(super) fn validate_gains(&self) -> Result<(), ScenarioError> {
         non_negative("controller.p", self.p)?;
         non_negative("controller.i", self.i)?;
         non_negative("controller.d", self.d)?;
@@ -166,11 +209,12 @@ impl Controller {
                 positive("controller.q_integral", self.q_integral)?;
                 positive("controller.r", self.r)?;
             }
+            ControllerKind::Length => {}
         }
-        self.validate_limits(robot)
+        Ok(())
     }
 
-    fn validate_limits(&self, robot: &Robot) -> Result<(), ScenarioError> {
+    pub(super) fn validate_limits(&self, robot: &Robot) -> Result<(), ScenarioError> {
         let weight = robot.effector_mass * robot.gravity;
         if let Some(t_min) = self.t_min {
             finite("controller.t_min", t_min)?;

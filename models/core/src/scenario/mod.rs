@@ -8,8 +8,9 @@ use serde::Deserialize;
 
 mod controller;
 mod error;
+mod spatial;
 mod validate;
-pub use controller::{Controller, ControllerKind};
+pub use controller::{Controller, ControllerKind, FlexCompensation};
 pub use error::{
     MAX_ELEMENTS, ScenarioError, count_in_range, finite, non_negative, out_of_range, positive,
 };
@@ -128,6 +129,13 @@ pub struct Trajectory {
     /// The EI family's tolerated residual vibration V_tol (0, 1).
     #[serde(skip_serializing_if = "is_default_vtol")]
     pub shaper_vtol: f64,
+    /// A spatial robot's move: the start pose [x, y, z] [m] (eq. 13 along the straight segment
+    /// to `end`; x1, x2 are the plane's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub start: Option<Vec<f64>>,
+    /// A spatial robot's move: the end pose [x, y, z] [m].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end: Option<Vec<f64>>,
 }
 
 fn is_default<T: Default + PartialEq>(v: &T) -> bool {
@@ -213,6 +221,8 @@ impl Default for Trajectory {
             shaper_frequency: Designed::default(),
             shaper_damping: Designed::default(),
             shaper_vtol: DEFAULT_VTOL,
+            start: None,
+            end: None,
         }
     }
 }

@@ -9,7 +9,28 @@ impl Scenario {
         if self.robot.anchors.is_some() {
             return self.validate_spatial();
         }
+        if let Some(start) = self
+            .trajectory
+            .start
+            .as_ref()
+            .or(self.trajectory.end.as_ref())
+        {
+            return Err(out_of_range(
+                "trajectory.start, trajectory.end",
+                format!("{start:?}"),
+                "absent for the planar robot (its move is x1 → x2); a spatial robot gives \
+                 [robot] anchors",
+            ));
+        }
         self.validate_robot_and_cable()?;
+        if self.controller.kind == ControllerKind::Length {
+            return Err(out_of_range(
+                "controller.kind",
+                "\"length\"",
+                "a tension controller for the planar robot; `length` drives a spatial robot's \
+                 reels ([robot] anchors)",
+            ));
+        }
         self.controller.validate(&self.robot)?;
         self.validate_trajectory()?;
         self.validate_simulation()
@@ -25,7 +46,7 @@ impl Scenario {
         self.validate_cable()
     }
 
-    fn validate_cable(&self) -> Result<(), ScenarioError> {
+    pub(super) fn validate_cable(&self) -> Result<(), ScenarioError> {
         let c = &self.cable;
         positive("cable.youngs_modulus", c.youngs_modulus)?;
         positive("cable.area", c.area)?;
@@ -99,7 +120,7 @@ impl Scenario {
         Ok(())
     }
 
-    fn validate_simulation(&self) -> Result<(), ScenarioError> {
+    pub(super) fn validate_simulation(&self) -> Result<(), ScenarioError> {
         let s = &self.simulation;
         positive("simulation.t_final", s.t_final)?;
         finite("simulation.rtol", s.rtol)?;
@@ -155,73 +176,6 @@ impl Scenario {
             return Err(out_of_range("simulation.rho_inf", s.rho_inf, "[0, 1]"));
         }
 
-        Ok(())
-    }
-
-    /// A spatial robot (`[robot] anchors`): its anchors, mass, cable and the tension box its
-    /// distribution needs. The planar sections (trajectory, PID) do not apply to it yet.
-    fn validate_spatial(&self) -> Result<(), ScenarioError> {
-        let r = &self.robot;
-        let anchors = r.anchors.as_deref().unwrap_or_default();
-        let m = anchors.len();
-        if !(2..=crate::robot::MAX_CABLES).contains(&m) {
-            return Err(out_of_range(
-                "robot.anchors",
-                format!("{m} anchors"),
-                format!("2 to {} anchors", crate::robot::MAX_CABLES),
-            ));
-        }
-        for (i, a) in anchors.iter().enumerate() {
-            if a.len() != 3 || !a.iter().all(|v| v.is_finite()) {
-                return Err(out_of_range(
-                    "robot.anchors",
-                    format!("anchor {} = {a:?}", i + 1),
-                    "three finite coordinates [x, y, z] m",
-                ));
-            }
-        }
-        let point = |i: usize| crate::robot::Vector::<3>::from_column_slice(&anchors[i]);
-        for (i, a) in anchors.iter().enumerate() {
-            for j in i + 1..m {
-                if (point(i) - point(j)).norm() < 1e-9 {
-                    return Err(out_of_range(
-                        "robot.anchors",
-                        format!("anchors {} and {} both at {a:?}", i + 1, j + 1),
-                        "distinct points (> 1 nm apart)",
-                    ));
-                }
-            }
-        }
-        let spread = (1..m).fold(crate::robot::Vector::<3>::zeros(), |n, k| {
-            let c = (point(k) - point(0)).cross(&(point(1) - point(0)));
-            if c.norm() > n.norm() { c } else { n }
-        });
-        if m > 2 && spread.norm() < 1e-9 {
-            return Err(out_of_range(
-                "robot.anchors",
-                format!("{m} anchors on one line"),
-                "anchors not all collinear: the cables must pull in three directions",
-            ));
-        }
-        positive("robot.effector_mass", r.effector_mass)?;
-        positive("robot.gravity", r.gravity)?;
-        self.validate_cable()?;
-        let (Some(t_min), Some(t_max)) = (self.controller.t_min, self.controller.t_max) else {
-            return Err(out_of_range(
-                "controller.t_min, controller.t_max",
-                "absent",
-                "both given for a spatial robot: the tension distribution's box [N]",
-            ));
-        };
-        non_negative("controller.t_min", t_min)?;
-        finite("controller.t_max", t_max)?;
-        if t_max <= t_min {
-            return Err(out_of_range(
-                "controller.t_max",
-                t_max,
-                format!("> t_min = {t_min} N"),
-            ));
-        }
         Ok(())
     }
 }

@@ -1,0 +1,116 @@
+//! `length`: the reels follow unstrained lengths, as stepper-driven printer firmware does
+//! (Hangprinter on RepRapFirmware, Klipper's winch kinematics): no tension feedback, no
+//! dynamics, each reel paid out to
+//!
+//! ```text
+//! l0_i(t) = l_i(p_ref(t)) / (1 + T_i(t)/EA)
+//! ```
+//!
+//! with T(t) the scenario's distribution of the static load M g at p_ref(t) (`flex_compensation
+//! = "static"`, the firmware's), or of M (a_ref − g⃗) (`"dynamic"`); or, with `"none"`, the
+//! lengths at the start pose shifted by the geometric length change, l0_i(t) = l0_i(0) +
+//! l_i(p_ref(t)) − l_i(p_ref(0)). The cables then pull with what their strain gives: on the
+//! massless elastic cables T_i = max(0, EA (l_i(p) − l0_i)/l0_i) (eq. 1 solved for T; a
+//! slack cable pulls with nothing, and the run goes on), so this
+//! "controller" maps the measured pose to the cables' tensions the way the reels' lengths make
+//! them; nothing keeps them in the tension box, and the loop does not clamp them.
+
+use super::distribution::TensionSolver;
+use super::{Controller, Measures, Output, Reference, Rest, StepStart};
+use crate::robot::{Effector, PerCable, Robot, Tensions, Vector};
+use crate::scenario::{self, ControllerKind, FlexCompensation};
+
+/// Reels driven by length.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LengthControl<const D: usize> {
+    pub robot: Robot<D>,
+    /// EA [N].
+    pub axial_stiffness: f64,
+    pub flex: FlexCompensation,
+    /// The distribution whose tensions the flex compensation assumes.
+    pub solver: TensionSolver,
+    /// The reference's start pose [m] (the `"none"` compensation's calibration pose).
+    pub start: Vector<D>,
+}
+
+impl<const D: usize> LengthControl<D> {
+    pub fn new(scenario: &scenario::Scenario, robot: Robot<D>) -> Self {
+        let start = scenario
+            .trajectory
+            .start
+            .as_ref()
+            .map_or_else(Vector::zeros, |s| Vector::from_iterator(s.iter().copied()));
+        Self {
+            robot,
+            axial_stiffness: scenario.cable.axial_stiffness(),
+            flex: scenario.controller.flex_compensation,
+            solver: TensionSolver::from(&scenario.controller),
+            start,
+        }
+    }
+
+    /// The unstrained lengths l0_i the reels pay out for `reference` [m].
+    pub fn reel_lengths(&self, reference: &Reference<D>) -> PerCable {
+        let r = &self.robot;
+        let p = reference.position;
+        let stretched = |p: &Vector<D>, load: &Vector<D>| {
+            let t = self.solver.for_acceleration(r, p, load);
+            PerCable::from_fn(r.cables(), |i| {
+                r.chord(i, p).length / (1.0 + t[i] / self.axial_stiffness)
+            })
+        };
+        match self.flex {
+            FlexCompensation::Static => stretched(&p, &Vector::zeros()),
+            FlexCompensation::Dynamic => stretched(&p, &reference.acceleration),
+            FlexCompensation::None => {
+                let calibrated = stretched(&self.start, &Vector::zeros());
+                PerCable::from_fn(r.cables(), |i| {
+                    calibrated[i] + r.chord(i, &p).length - r.chord(i, &self.start).length
+                })
+            }
+        }
+    }
+}
+
+impl<const D: usize> Controller<D> for LengthControl<D> {
+    fn kind(&self) -> ControllerKind {
+        ControllerKind::Length
+    }
+    fn state_len(&self) -> usize {
+        0
+    }
+    fn uses_reference_derivatives(&self) -> bool {
+        self.flex == FlexCompensation::Dynamic
+    }
+    fn measures(&self) -> Measures {
+        Measures {
+            all_axes: true,
+            velocity: false,
+        }
+    }
+    /// The cables' tensions from their strain at the measured pose; the wrench is their pull.
+    fn output(&self, reference: &Reference<D>, effector: &Effector<D>, _: &[f64]) -> Output<D> {
+        let l0 = self.reel_lengths(reference);
+        let r = &self.robot;
+        let tensions = Tensions::from_fn(r.cables(), |i| {
+            let l = r.chord(i, &effector.position).length;
+            // A cable shorter than its unstrained length is slack: it cannot push.
+            (self.axial_stiffness * (l - l0[i]) / l0[i]).max(0.0)
+        });
+        Output {
+            wrench: r.structure_matrix(&effector.position).force(&tensions),
+            tensions,
+        }
+    }
+    fn state_rate(&self, _: &Reference<D>, _: &Effector<D>, _: &[f64], _: bool, _: &mut [f64]) {}
+    fn trapezoidal_step(
+        &self,
+        _: f64,
+        _: &StepStart<D>,
+        _: &Reference<D>,
+        _: &Effector<D>,
+        _: &mut [f64],
+    ) {
+    }
+    fn rest_states(&self, _: &Reference<D>, _: &Effector<D>, _: &Rest, _: &mut [f64]) {}
+}

@@ -1,0 +1,199 @@
+//! A spatial robot's run (MODELS.md §11): the massless elastic cables in space under the
+//! scenario's controller and tension distribution. Before any work the whole reference is checked
+//! for wrench feasibility — at rest and with its acceleration, by the exact QP — so that a move
+//! leaving the feasible workspace is refused with the time, the pose and the cable that cannot
+//! hold, never run into saturation silently.
+
+use crate::config::ModelConfig;
+use crate::kind::ModelKind;
+use crate::study::Error;
+use cdpr_analysis::spatial::{SpatialContext, SpatialMetrics};
+use cdpr_core::closed_loop::ClosedLoop;
+use cdpr_core::model::ModelParams;
+use cdpr_core::robot::distribution::{
+    BOX_TOLERANCE, Bound, DistributionMethod, TensionBox, distribute,
+};
+use cdpr_core::robot::{Robot, Vector, along_vertical};
+use cdpr_core::runner::{Observer, Run, RunOptions, simulate_observed_reusing};
+use cdpr_core::scenario::{Scenario, out_of_range};
+use cdpr_core::series::SeriesBuffer;
+use cdpr_core::shaper::Impulses;
+use cdpr_core::trajectory::Segment;
+use cdpr_elastic::Elastic;
+
+/// Instants of the reference checked for feasibility over the move (plus its start and end).
+pub const FEASIBILITY_SAMPLES: usize = 2000;
+
+/// A reference the cables cannot follow inside their box.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "the reference leaves the wrench-feasible workspace at t = {t} s, pose {pose:?} m ({load}): \
+     no tensions in the box [{t_min}, {t_max}] N supply the wrench {wrench:?} N; cable {cable} \
+     would need to go {bound:?}"
+)]
+pub struct InfeasibleReference {
+    pub t: f64,
+    pub pose: [f64; 3],
+    /// "at rest" or "with its acceleration".
+    pub load: &'static str,
+    pub wrench: [f64; 3],
+    /// The cable (from 1) farthest outside the box in the minimum-norm solution.
+    pub cable: usize,
+    pub bound: Bound,
+    pub t_min: f64,
+    pub t_max: f64,
+}
+
+/// A spatial run and its metrics.
+pub struct SpatialRun {
+    pub run: Run,
+    pub metrics: SpatialMetrics,
+}
+
+/// The spatial robot's move, shaper and tension box, checked: the model elastic (massive
+/// cables run on the plane's robot only, so far), the move given for three or more cables, the
+/// reference feasible.
+pub fn prepare_spatial(scenario: &Scenario) -> Result<Robot<3>, Error> {
+    let robot = scenario.spatial_robot().ok_or_else(|| {
+        out_of_range(
+            "robot.anchors",
+            "absent",
+            "[[x, y, z], …] for a spatial run (the planar robot runs `simulate`)",
+        )
+    })?;
+    let kind = ModelConfig::from_scenario(scenario)?.kind;
+    if kind != ModelKind::Elastic {
+        return Err(out_of_range(
+            "model.kind",
+            format!("\"{kind}\" with robot.anchors"),
+            "\"elastic\": a spatial robot runs the massless elastic cables (the massive \
+             cables are planar so far)",
+        )
+        .into());
+    }
+    cdpr_elastic::Params {}.validate(scenario)?;
+    if robot.cables() >= 3 {
+        let path = segment(scenario)?;
+        let shaper = scenario.trajectory.impulses()?;
+        check_reference(scenario, &robot, &path, shaper.as_ref())?;
+    }
+    Ok(robot)
+}
+
+/// The scenario's move as a segment.
+fn segment(scenario: &Scenario) -> Result<Segment<3>, Error> {
+    let (start, end) = scenario.trajectory.spatial_move()?;
+    Ok(Segment {
+        start: Vector::from(start),
+        end: Vector::from(end),
+        t1: scenario.trajectory.t1,
+        t2: scenario.trajectory.t2,
+    })
+}
+
+/// The wrench-feasibility check of the whole reference: at [`FEASIBILITY_SAMPLES`] instants
+/// of the (shaped) move and its start and end, the exact QP must find tensions in the box for
+/// the weight alone (the robot may stop anywhere) and for M (a_ref − g⃗).
+pub fn check_reference(
+    scenario: &Scenario,
+    robot: &Robot<3>,
+    path: &Segment<3>,
+    shaper: Option<&Impulses>,
+) -> Result<(), Error> {
+    let limits = TensionBox {
+        t_min: scenario.controller.t_min.unwrap_or(0.0),
+        t_max: scenario.controller.t_max.unwrap_or(f64::INFINITY),
+    };
+    let end = path.t2 + shaper.map_or(0.0, Impulses::duration);
+    let mass = robot.effector_mass;
+    let n = FEASIBILITY_SAMPLES;
+    for k in 0..=n + 1 {
+        let t = if k == 0 {
+            0.0
+        } else {
+            path.t1 + (end - path.t1) * (k - 1) as f64 / n as f64
+        };
+        let [p, _, a] = path.shaped(shaper, t, true);
+        let lift = along_vertical::<3>(robot.gravity);
+        for (load, wrench) in [
+            ("at rest", lift * mass),
+            ("with its acceleration", (a + lift) * mass),
+        ] {
+            let w = robot.structure_matrix(&p);
+            let d = distribute(DistributionMethod::Qp, &w, &wrench, limits).map_err(|e| {
+                out_of_range(
+                    "trajectory",
+                    format!("pose {:?} m at t = {t} s", p.as_slice()),
+                    format!("a pose where the cables span every direction ({e})"),
+                )
+            })?;
+            if !d.feasible {
+                let (cable, bound) = worst_cable(&d.tensions, limits);
+                return Err(InfeasibleReference {
+                    t,
+                    pose: [p[0], p[1], p[2]],
+                    load,
+                    wrench: [wrench[0], wrench[1], wrench[2]],
+                    cable: cable + 1,
+                    bound,
+                    t_min: limits.t_min,
+                    t_max: limits.t_max,
+                }
+                .into());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The cable farthest outside the box, and which bound it crosses.
+fn worst_cable(tensions: &[f64], limits: TensionBox) -> (usize, Bound) {
+    let mut worst = (0, Bound::Min, f64::NEG_INFINITY);
+    for (i, &t) in tensions.iter().enumerate() {
+        for (bound, excess) in [
+            (Bound::Min, limits.t_min - t),
+            (Bound::Max, t - limits.t_max),
+        ] {
+            if excess > worst.2 + BOX_TOLERANCE {
+                worst = (i, bound, excess);
+            }
+        }
+    }
+    (worst.0, worst.1)
+}
+
+/// Runs a spatial scenario, watched and steered by `observer`, and measures it.
+pub fn simulate_spatial(scenario: &Scenario, observer: &mut Observer) -> Result<SpatialRun, Error> {
+    let robot = prepare_spatial(scenario)?;
+    let model = Elastic::new(robot, scenario.cable.axial_stiffness());
+    let mut sys = ClosedLoop::new(model, scenario)?;
+    let run = simulate_observed_reusing(
+        &mut sys,
+        &RunOptions::from(scenario),
+        SeriesBuffer::default(),
+        observer,
+    )?;
+    let metrics = spatial_metrics(scenario, &sys, &run);
+    Ok(SpatialRun { run, metrics })
+}
+
+/// The metrics of a spatial run of `scenario` on the loop `sys`.
+pub fn spatial_metrics<M: cdpr_core::model::CableModel<3>>(
+    scenario: &Scenario,
+    sys: &ClosedLoop<M, 3>,
+    run: &Run,
+) -> SpatialMetrics {
+    let context = SpatialContext {
+        path: sys.path,
+        shaper: sys.shaper.clone(),
+        move_start: scenario.trajectory.t1,
+        move_end: sys.move_end(),
+        controller: scenario.controller.kind.name(),
+        distribution: if sys.robot().cables() > 3 {
+            scenario.controller.distribution.name()
+        } else {
+            "none"
+        },
+    };
+    SpatialMetrics::from_run(run, &context)
+}

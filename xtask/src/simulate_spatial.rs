@@ -1,0 +1,136 @@
+//! `cargo xtask simulate` of a spatial robot (`[robot] anchors`): the same guarantees as the
+//! planar run — checked before work (here also the whole reference's wrench feasibility), `--out`
+//! locked, samples streamed to `timeseries.partial.csv`, SIGINT/SIGTERM honoured, always a
+//! `metrics.json` saying how the run ended — with the spatial metrics (3-D path error, tensions
+//! and reel speeds per cable).
+
+use crate::output::{Progress, write_json};
+use crate::simulate::{CsvStream, METRICS, PARTIAL, STOP, TIMESERIES, prepare_out, writable_out};
+use anyhow::{Context, Result, bail};
+use cdpr_bench::analysis::spatial::SpatialMetrics;
+use cdpr_bench::core::channel::heading;
+use cdpr_bench::core::closed_loop::ClosedLoop;
+use cdpr_bench::core::runner::{Observer, RunError, channel_names, channel_units};
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::{Error, Provenance, SpatialRun};
+use cdpr_sweep::DirLock;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::atomic::Ordering;
+
+/// `metrics.json` of a spatial run.
+#[derive(serde::Serialize)]
+struct SpatialMetricsFile<'a> {
+    status: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    error: Option<String>,
+    t_reached: f64,
+    provenance: &'a Provenance,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    metrics: Option<&'a SpatialMetrics>,
+    /// Accepted steps and right-hand-side evaluations: the run's cost.
+    steps: u64,
+    rhs_evaluations: u64,
+    units: BTreeMap<&'static str, &'static str>,
+}
+
+/// Runs the spatial `scenario` into `out`, every `every`-th sample written.
+pub fn run(scenario: &Scenario, out: &Path, every: usize) -> Result<()> {
+    let robot = cdpr_bench::prepare_spatial(scenario)?;
+    let provenance = Provenance::of(scenario)?;
+    writable_out(out)?;
+    let _lock = DirLock::acquire(out, "simulate")?;
+    prepare_out(out)?;
+    let model = cdpr_bench::elastic::Elastic::new(robot, scenario.cable.axial_stiffness());
+    let headings: Vec<String> = channel_names(&model)
+        .iter()
+        .zip(channel_units(&model))
+        .map(|(name, unit)| heading(name, unit))
+        .collect();
+    // Built here too, so that a controller that cannot be designed fails before any file.
+    ClosedLoop::new(model, scenario).map_err(Error::from)?;
+    ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
+        .context("installing the SIGINT/SIGTERM handler")?;
+    let mut stream = CsvStream::create(out.join(PARTIAL), &headings, every)?;
+    let mut progress = Progress::new("elastic (space)");
+    let result = {
+        let mut on_sample = |row: &[f64]| stream.push(row);
+        let mut report = |f: f64| progress.set(f);
+        let mut observer = Observer {
+            progress: &mut report,
+            on_sample: Some(&mut on_sample),
+            stop: Some(&STOP),
+        };
+        cdpr_bench::simulate_spatial(scenario, &mut observer)
+    };
+    progress.finish();
+    let write_failure = stream.failure();
+    let (done, status, error): (Option<SpatialRun>, _, _) = match result {
+        Ok(done) => (Some(done), "complete", write_failure),
+        Err(Error::Run(failure)) => {
+            let status = match (&write_failure, &failure.error) {
+                (None, RunError::Interrupted { .. }) => "interrupted",
+                _ => "failed",
+            };
+            let error = write_failure.unwrap_or_else(|| failure.error.to_string());
+            let done = failure.partial.map(|run| {
+                let model =
+                    cdpr_bench::elastic::Elastic::new(robot, scenario.cable.axial_stiffness());
+                let metrics = ClosedLoop::new(model, scenario)
+                    .map(|sys| cdpr_bench::spatial_metrics(scenario, &sys, &run))
+                    .ok();
+                (run, metrics)
+            });
+            match done {
+                Some((run, Some(metrics))) => {
+                    (Some(SpatialRun { run, metrics }), status, Some(error))
+                }
+                _ => (None, status, Some(error)),
+            }
+        }
+        Err(e) => (None, "failed", Some(e.to_string())),
+    };
+    let empty = cdpr_bench::core::series::TimeSeries::new(Vec::new());
+    let written = stream.finish(
+        done.as_ref().map_or(&empty, |d| &d.run.series),
+        &out.join(TIMESERIES),
+    );
+    let units = SpatialMetrics::UNITS
+        .into_iter()
+        .chain([("t_reached", "s"), ("move_end_s", "s")]);
+    write_json(
+        &out.join(METRICS),
+        &SpatialMetricsFile {
+            status,
+            error: error.clone(),
+            t_reached: done.as_ref().map_or(0.0, |d| d.run.t_reached),
+            provenance: &provenance,
+            metrics: done.as_ref().map(|d| &d.metrics),
+            steps: done.as_ref().map_or(0, |d| d.run.stats.steps_accepted),
+            rhs_evaluations: done.as_ref().map_or(0, |d| d.run.stats.rhs_evals),
+            units: units.collect(),
+        },
+    )?;
+    written?;
+    if let Some(d) = &done {
+        println!(
+            "elastic in space, {} cables: {} samples, {} RHS evaluations, {} accepted steps; path error during the move {:.3e} m, 1 s after {:.3e} m → {}",
+            d.metrics.cables,
+            d.run.series.len(),
+            d.run.stats.rhs_evals,
+            d.run.stats.steps_accepted,
+            d.metrics.path_err_max_move,
+            d.metrics.path_err_max_after_1s,
+            out.display()
+        );
+    }
+    match error {
+        None => Ok(()),
+        Some(e) => bail!(
+            "{e}; {status} run kept up to t = {} s in {} and {}",
+            done.as_ref().map_or(0.0, |d| d.run.t_reached),
+            out.join(TIMESERIES).display(),
+            out.join(METRICS).display()
+        ),
+    }
+}

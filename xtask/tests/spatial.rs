@@ -1,0 +1,155 @@
+//! `cargo xtask simulate` and `cargo xtask spatial-moves` on a spatial robot, as a printer
+//! builder runs them: the files, their channels and metrics, checked against what the test
+//! computes itself from the anchors; refusals before any file is written.
+
+mod common;
+
+use common::TempDir;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn example(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples/robots")
+        .join(name)
+}
+
+fn xtask(args: &[&str], scenario: &Path, out: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_xtask"))
+        .args(args)
+        .arg("--scenario")
+        .arg(scenario)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
+/// The Hangprinter example's move: every sample's tensions pull the effector with W T, W from
+/// the anchors here, the effector's own acceleration M p̈ + M g (second differences of the
+/// samples, O(Δt²) with the dense output's interpolation: 1.9e-5 N seen, 1e-4 N allowed, of
+/// 16 N); the lengths are the anchors' distances; the metrics
+/// reproduce from the CSV.
+#[test]
+fn hangprinter_move_writes_a_consistent_record() {
+    let dir = TempDir::new("spatial-simulate");
+    let out = dir.join("out");
+    let run = xtask(&["simulate"], &example("hangprinter.toml"), &out);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let metrics: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(metrics["status"], "complete");
+    assert_eq!(metrics["cables"], 4);
+    assert!(metrics["path_err_max_move"].as_f64().unwrap() < 1e-6);
+    let text = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
+    let mut lines = text.lines();
+    let names: Vec<&str> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|h| h.split(" [").next().unwrap())
+        .collect();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let col = |name: &str| names.iter().position(|n| *n == name).unwrap();
+    let anchors = [
+        [0.0, -1.61098, -0.13153],
+        [1.31422, 1.26814, -0.12128],
+        [-1.41573, 0.70761, -0.12182],
+        [0.0, 0.0, 2.29983],
+    ];
+    let dt = rows[1][0] - rows[0][0];
+    let mut t_max_seen = f64::NEG_INFINITY;
+    for k in 1..rows.len() - 1 {
+        let p = |r: &Vec<f64>| [r[col("x")], r[col("y")], r[col("z")]];
+        let (a, b, c) = (p(&rows[k - 1]), p(&rows[k]), p(&rows[k + 1]));
+        let mut pull = [0.0; 3];
+        for (i, anchor) in anchors.iter().enumerate() {
+            let d: Vec<f64> = (0..3).map(|j| anchor[j] - b[j]).collect();
+            let l = d.iter().map(|v| v * v).sum::<f64>().sqrt();
+            assert!((rows[k][col(&format!("l{}", i + 1))] - l).abs() < 1e-12);
+            let t = rows[k][col(&format!("T{}", i + 1))];
+            t_max_seen = t_max_seen.max(t);
+            for j in 0..3 {
+                pull[j] += t * d[j] / l;
+            }
+        }
+        // step5's jerk jumps at t1 = 0 and t2 = 0.2 s: a second difference straddling the jump
+        // is off by ~ jerk Δt / 3 ≈ 0.03 N there.
+        if (rows[k][0] - 0.2).abs() < 1.5 * dt {
+            continue;
+        }
+        for j in 0..3 {
+            let acc = (a[j] - 2.0 * b[j] + c[j]) / (dt * dt);
+            let needed = acc + if j == 2 { 9.81 } else { 0.0 };
+            assert!(
+                (pull[j] - needed).abs() < 2e-3,
+                "t = {}: axis {j}",
+                rows[k][0]
+            );
+        }
+    }
+    assert_eq!(metrics["tension_max"].as_f64().unwrap(), t_max_seen);
+}
+
+/// Refused before any file: a reference the box cannot follow (named with time, pose, cable),
+/// a robot described for its statics only (no move), and a massive cable model in space.
+#[test]
+fn spatial_runs_are_refused_before_any_file() {
+    let dir = TempDir::new("spatial-refusals");
+    let base = std::fs::read_to_string(example("hangprinter.toml")).unwrap();
+    let fast = base.replace("t2 = 0.2", "t2 = 0.03");
+    let lumped = format!("{base}\n[model]\nkind = \"lumped\"\n");
+    for (file, text, expected) in [
+        ("fast.toml", fast, "wrench-feasible workspace at t ="),
+        ("lumped.toml", lumped, "model.kind"),
+    ] {
+        let path = dir.join(file);
+        std::fs::write(&path, text).unwrap();
+        let out = dir.join(file.replace(".toml", ""));
+        let run = xtask(&["simulate"], &path, &out);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(
+            !run.status.success() && stderr.contains(expected),
+            "{file}: {stderr}"
+        );
+        assert!(!out.join("metrics.json").exists(), "{file}");
+    }
+    let statics_only = xtask(&["simulate"], &example("cogiro.toml"), &dir.join("cogiro"));
+    let stderr = String::from_utf8_lossy(&statics_only.stderr);
+    assert!(stderr.contains("trajectory.start"), "{stderr}");
+}
+
+/// The docs' table: every controller × distribution, the tension controllers within 1 µm.
+#[test]
+fn spatial_moves_table() {
+    let dir = TempDir::new("spatial-moves");
+    let out = dir.join("out");
+    let run = xtask(&["spatial-moves"], &example("hangprinter.toml"), &out);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let rows: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("moves.json")).unwrap()).unwrap();
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 6 * 4);
+    for r in rows {
+        let controller = r["controller"].as_str().unwrap();
+        let err = r["metrics"]["path_err_max_move"].as_f64().unwrap();
+        if controller == "computed-torque" || controller == "lqr" {
+            assert!(err < 1e-6, "{controller}: {err}");
+        }
+    }
+    assert!(
+        std::fs::read_to_string(out.join("moves.md"))
+            .unwrap()
+            .contains("| length/static |")
+    );
+}
