@@ -16,6 +16,7 @@ pub use rest::LoopError;
 
 use crate::controller::{self, AnyController, Controller, Reference, TensionLimits};
 use crate::model::CableModel;
+use crate::robot::distribution::BOX_TOLERANCE;
 use crate::robot::{Effector, Robot, Tensions, Vector};
 use crate::scenario::{ControllerKind, Scenario};
 use crate::shaper::Impulses;
@@ -204,23 +205,6 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         self.controller.kind() == ControllerKind::Length
     }
 
-    /// How far the controller's tensions at (t, y) lie outside the limits before the clamp [N]
-    /// (≤ 0: inside). A spatial run's `saturated` channel counts a clamp beyond the
-    /// distribution's [`BOX_TOLERANCE`](crate::robot::distribution::BOX_TOLERANCE), not the
-    /// round-off of a cable the distribution put on a bound.
-    pub fn clamp_excess(&self, t: f64, y: &[f64]) -> f64 {
-        let n = self.model_len();
-        let effector = self.model.effector(&y[..n]);
-        let states = &y[n..n + self.controller_len()];
-        let out = self
-            .controller
-            .output(&self.reference(t), &effector, states);
-        out.tensions
-            .iter()
-            .map(|&t| (self.limits.t_min - t).max(t - self.limits.t_max))
-            .fold(f64::NEG_INFINITY, f64::max)
-    }
-
     /// The command for a given reference, effector and controller states.
     #[inline]
     fn command_with(
@@ -231,10 +215,15 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         states: &[f64],
     ) -> Command {
         let out = self.controller.output(reference, effector, states);
-        let (tensions, saturated) = match &self.actuation {
+        let (tensions, mut saturated) = match &self.actuation {
             Actuation::Controller => self.limits.clamp(&out.tensions),
             Actuation::Prescribed(f) => (f(t), false),
         };
+        if D == 3 && saturated {
+            // In space a distribution's cable on a bound may lie an ulp past it: saturation
+            // (and the anti-windup it triggers) is a clamp beyond the distribution's tolerance.
+            saturated = self.limits.excess(&out.tensions) > BOX_TOLERANCE;
+        }
         Command {
             reference: reference.position[0],
             error: reference.position[0] - effector.position[0],

@@ -81,6 +81,14 @@ impl TensionLimits {
         let clamped = tensions.map(|t| t.clamp(self.t_min, self.t_max));
         (clamped, clamped != *tensions)
     }
+
+    /// How far the farthest tension lies outside the limits [N] (≤ 0: all inside).
+    pub fn excess(&self, tensions: &Tensions) -> f64 {
+        tensions
+            .iter()
+            .map(|&t| (self.t_min - t).max(t - self.t_max))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
 }
 
 /// How a controller's force on the effector becomes m tensions (MODELS.md §11): W T = f solved

@@ -310,6 +310,7 @@ fn puncture<const D: usize>(
 /// T(λ) = clamp(Wᵀλ), so a λ with W T(λ) = w makes T(λ) the optimum (KKT hold by construction).
 /// Newton on ∇q = w − W T(λ) with the free cables' Gram matrix and a backtracking line search;
 /// if it does not settle (an infeasible problem's dual is unbounded), every active set is tried.
+/// One degree of redundancy has its exact closed form ([`qp_on_the_line`]).
 fn qp<const D: usize>(
     w: &StructureMatrix<D>,
     wrench: &Vector<D>,
@@ -318,6 +319,9 @@ fn qp<const D: usize>(
     let m = w.columns().len();
     let all = [true; MAX_CABLES];
     let g_inv = gram_inverse(w, &all[..m]).ok_or(DistributionError::RankDeficient { axes: D })?;
+    if m == D + 1 {
+        return Ok(qp_on_the_line(w, wrench, &g_inv, limits));
+    }
     let scale = wrench.norm() + limits.t_max.abs().max(limits.t_min.abs());
     let tol = 1e-13 * scale;
     let clamp = |z: f64| z.clamp(limits.t_min, limits.t_max);
@@ -359,6 +363,82 @@ fn qp<const D: usize>(
         lambda += step * alpha;
     }
     Ok(qp_by_enumeration(w, wrench, limits, tol))
+}
+
+/// The QP with one degree of redundancy (m = D + 1, Hangprinter), exactly and without
+/// iterating: the solutions of W T = w are the line T(s) = W⁺w + s n, n the unit null vector of
+/// W, and W⁺w ⟂ n, so ‖T(s)‖² = ‖W⁺w‖² + s² is least at the s of the box's interval
+/// [s_lo, s_hi] nearest 0. An empty interval: no distribution; W⁺w is returned, infeasible.
+fn qp_on_the_line<const D: usize>(
+    w: &StructureMatrix<D>,
+    wrench: &Vector<D>,
+    g_inv: &Matrix<D>,
+    limits: TensionBox,
+) -> Distribution {
+    let m = w.columns().len();
+    let lambda = g_inv * wrench;
+    let minimum_norm = Tensions::from_fn(m, |i| w.column(i).dot(&lambda));
+    // n = (I − W⁺W) e_k for the k with the largest diagonal 1 − u_kᵀ G⁻¹ u_k (the best-
+    // conditioned column of the projector), normalised.
+    let k = (0..m)
+        .map(|i| (i, 1.0 - w.column(i).dot(&(g_inv * w.column(i)))))
+        .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a })
+        .0;
+    let pull = g_inv * w.column(k);
+    let mut null = Tensions::from_fn(m, |i| f64::from(u8::from(i == k)) - w.column(i).dot(&pull));
+    let norm = null.iter().map(|v| v * v).sum::<f64>().sqrt();
+    null.iter_mut().for_each(|v| *v /= norm);
+    // Each cable's bounds on s; the cable that sets each end of the interval.
+    let (mut lo, mut hi) = ((f64::NEG_INFINITY, None), (f64::INFINITY, None));
+    for i in 0..m {
+        let (t, n) = (minimum_norm[i], null[i]);
+        if n.abs() < 1e-14 {
+            if limits.violation(t) > BOX_TOLERANCE {
+                (lo, hi) = ((f64::INFINITY, None), (f64::NEG_INFINITY, None));
+                break;
+            }
+            continue;
+        }
+        let (a, b) = ((limits.t_min - t) / n, (limits.t_max - t) / n);
+        let (from, to, bound_from, bound_to) = if n > 0.0 {
+            (a, b, Bound::Min, Bound::Max)
+        } else {
+            (b, a, Bound::Max, Bound::Min)
+        };
+        if from > lo.0 {
+            lo = (from, Some((CableId(i), bound_from)));
+        }
+        if to < hi.0 {
+            hi = (to, Some((CableId(i), bound_to)));
+        }
+    }
+    if lo.0 > hi.0 {
+        return Distribution {
+            feasible: inside(&minimum_norm, limits),
+            tensions: minimum_norm,
+            clamped: Vec::new(),
+        };
+    }
+    let s = 0.0f64.clamp(lo.0, hi.0);
+    let mut tensions = Tensions::from_fn(m, |i| minimum_norm[i] + s * null[i]);
+    let clamped: Vec<(CableId, Bound)> = match (s == lo.0, s == hi.0) {
+        (true, _) => lo.1.into_iter().collect(),
+        (_, true) => hi.1.into_iter().collect(),
+        _ => Vec::new(),
+    };
+    // The cable that sets s sits exactly on its bound (not an ulp past it, which a clamp
+    // downstream would count as saturation).
+    for &(cable, bound) in &clamped {
+        tensions[cable.index()] = match bound {
+            Bound::Min => limits.t_min,
+            Bound::Max => limits.t_max,
+        };
+    }
+    Distribution {
+        feasible: inside(&tensions, limits),
+        tensions,
+        clamped,
+    }
 }
 
 fn qp_result<const D: usize>(

@@ -69,8 +69,6 @@ impl Sampler {
             let m = self.model_channels;
             let cables = cmd.tensions.len();
             let flag = usize::from(D == 3);
-            let saturated =
-                flag == 1 && sys.clamp_excess(tk, y) > crate::robot::distribution::BOX_TOLERANCE;
             self.series.push_row_with(|row| {
                 let (common, rest) = row.split_at_mut(4 + D + cables + flag);
                 let (own, energies) = rest.split_at_mut(m);
@@ -81,7 +79,7 @@ impl Sampler {
                 common[3 + D] = cmd.force;
                 common[4 + D..4 + D + cables].copy_from_slice(&cmd.tensions);
                 if flag == 1 {
-                    common[4 + D + cables] = f64::from(u8::from(saturated));
+                    common[4 + D + cables] = f64::from(u8::from(cmd.saturated));
                 }
                 sys.model.channels(model_state, &cmd.tensions, own);
                 energies.copy_from_slice(&[
