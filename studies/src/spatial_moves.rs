@@ -80,7 +80,7 @@ pub fn table(scenario: &Scenario) -> Result<Vec<MoveRow>> {
 /// The table in Markdown.
 pub fn markdown(rows: &[MoveRow]) -> String {
     let mut out = String::from(
-        "| controller | distribution | path error in the move [µm] | 1 s after [µm] | \
+        "| controller | distribution | path error in the move [m] | 1 s after [m] | \
          tensions [N] | saturated [s] | reel speed [m/s] | steps |\n|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
@@ -90,8 +90,8 @@ pub fn markdown(rows: &[MoveRow]) -> String {
             "| {} | {} | {} | {} | {:.1} … {:.1} | {:.3} | {:.3} | {} |\n",
             r.controller,
             r.distribution,
-            micro(m.path_err_max_move),
-            micro(m.path_err_max_after_1s),
+            metres(m.path_err_max_move),
+            metres(m.path_err_max_after_1s),
             m.tension_min,
             m.tension_max,
             m.saturated_s,
@@ -102,10 +102,10 @@ pub fn markdown(rows: &[MoveRow]) -> String {
     out
 }
 
-/// A length in µm with three significant digits ("—" where not measured).
-fn micro(v: f64) -> String {
+/// A length in metres with three significant digits ("—" where not measured).
+fn metres(v: f64) -> String {
     if v.is_finite() {
-        format!("{:.3e}", v * 1e6)
+        format!("{v:.2e}")
     } else {
         "—".into()
     }
