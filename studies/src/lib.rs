@@ -9,6 +9,7 @@
 //! | every controller on every model (the leaderboard) | [`control`] | `cargo xtask control` |
 //! | a spatial robot's tension distributions at a pose | [`distribution`] | `cargo xtask distribution` |
 //! | every input shaper on every model | [`shaping`] | `cargo xtask shaping` |
+//! | a spatial robot's modes at a pose, with their directions | [`spatial_modes`] | `cargo xtask modes --at X,Y,Z` |
 //! | a spatial robot's move, every controller × distribution | [`spatial_moves`] | `cargo xtask spatial-moves` |
 //! | closed- and open-loop modes, the axial-damping sweep | [`modes`] | `cargo xtask modes` |
 //! | effector mass × move time grids | [`sweeps`] | part of the report |
@@ -23,6 +24,7 @@ pub mod paper;
 pub mod pool;
 pub mod samples;
 pub mod shaping;
+pub mod spatial_modes;
 pub mod spatial_moves;
 pub mod sweeps;
 

@@ -85,9 +85,15 @@ enum Command {
         /// Controller, overriding the scenario's `[controller] kind`.
         #[arg(long, value_enum)]
         controller: Option<ControllerKind>,
-        /// Effector position x [m]; absent = the trajectory's x1 and x2.
-        #[arg(long)]
-        at: Option<f64>,
+        /// Effector position x [m] (a spatial robot: X,Y,Z); absent = the trajectory's x1 and x2
+        /// (a spatial robot: the move's end).
+        #[arg(
+            long,
+            value_delimiter = ',',
+            num_args = 1,
+            allow_negative_numbers = true
+        )]
+        at: Vec<f64>,
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,

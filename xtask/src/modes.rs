@@ -4,7 +4,7 @@
 
 use crate::figures::{Drawing, model_color, power_label, render_drawing};
 use crate::output::write_atomic;
-use anyhow::Result;
+use anyhow::{Result, bail};
 use cdpr_bench::ModelKind;
 use cdpr_bench::analysis::modes::Analysis;
 use cdpr_bench::core::scenario::ControllerKind;
@@ -28,7 +28,7 @@ pub fn write_files(report: &ModesReport, out: &Path) -> Result<()> {
 pub fn run(
     scenario: Option<&Path>,
     controller: Option<ControllerKind>,
-    at: Option<f64>,
+    at: Vec<f64>,
     out: &Path,
 ) -> Result<()> {
     let mut base = crate::simulate::load_scenario(scenario, None)?;
@@ -37,6 +37,14 @@ pub fn run(
         base.trajectory.z_ref = None;
         base.validate()?;
     }
+    if base.robot.anchors.is_some() {
+        return spatial(&base, &at, out);
+    }
+    let at = match at[..] {
+        [] => None,
+        [x] => Some(x),
+        _ => bail!("--at {at:?}: one position x [m] for the planar robot"),
+    };
     let xs = match at {
         Some(x) => vec![x],
         None => vec![base.trajectory.x1, base.trajectory.x2],
@@ -181,5 +189,40 @@ where
         .border_style(RGBColor(160, 160, 160))
         .draw()
         .map_err(err)?;
+    Ok(())
+}
+
+/// A spatial robot's modes at `--at X,Y,Z` (default: the move's end) → modes.json, modes.md.
+fn spatial(scenario: &cdpr_bench::core::scenario::Scenario, at: &[f64], out: &Path) -> Result<()> {
+    let pose = match (at, scenario.trajectory.spatial_move()) {
+        (&[x, y, z], _) => [x, y, z],
+        ([], Ok((_, end))) => end,
+        // Two cables: the paper's rule at x, the statics find the rest.
+        (&[x], _)
+            if scenario
+                .robot
+                .anchors
+                .as_ref()
+                .is_some_and(|a| a.len() == 2) =>
+        {
+            [x, 0.0, 0.0]
+        }
+        ([], Err(_))
+            if scenario
+                .robot
+                .anchors
+                .as_ref()
+                .is_some_and(|a| a.len() == 2) =>
+        {
+            [scenario.trajectory.x2, 0.0, 0.0]
+        }
+        _ => bail!("--at {at:?}: the effector's pose X,Y,Z [m] for a spatial robot"),
+    };
+    crate::simulate::writable_out(out)?;
+    let report = cdpr_studies::spatial_modes::at_pose(scenario, pose)?;
+    crate::output::write_json(&out.join("modes.json"), &report)?;
+    let table = cdpr_studies::spatial_modes::markdown(&report);
+    write_atomic(&out.join("modes.md"), |w| w.write_all(table.as_bytes()))?;
+    print!("{table}");
     Ok(())
 }

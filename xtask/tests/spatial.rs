@@ -153,3 +153,83 @@ fn spatial_moves_table() {
             .contains("| length/static |")
     );
 }
+
+fn modes(dir: &Path, scenario_text: &str, at: &str) -> serde_json::Value {
+    let path = dir.join("s.toml");
+    std::fs::write(&path, scenario_text).unwrap();
+    let out = dir.join("modes");
+    let run = Command::new(env!("CARGO_BIN_EXE_xtask"))
+        .args(["modes", "--scenario"])
+        .arg(&path)
+        .args(["--at", at, "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(out.join("modes.json")).unwrap()).unwrap()
+}
+
+/// The paper's robot in space, closed by the paper's PID: the loop's out-of-plane mode (from
+/// the closed loop's finite-difference Jacobian) is the undamped pendulum ω_y² = Σ T_i/(M l_i),
+/// computed here from the rest pose and tensions the command reports (1e-6 relative: the
+/// differences' truncation).
+#[test]
+fn the_out_of_plane_mode_of_the_paper_robot_is_the_pendulum() {
+    let dir = TempDir::new("spatial-modes-plane");
+    let report = modes(
+        &dir,
+        "[robot]\nanchors = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]\n",
+        "0.6",
+    );
+    let pose: Vec<f64> = serde_json::from_value(report["pose"].clone()).unwrap();
+    let t: Vec<f64> = serde_json::from_value(report["tensions"].clone()).unwrap();
+    let l = [pose[0].hypot(pose[2]), (1.0 - pose[0]).hypot(pose[2])];
+    let pendulum = (t[0] / l[0] + t[1] / l[1]).sqrt();
+    let closed: Vec<&serde_json::Value> = report["modes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["linearisation"] == "closed" && m["name"] == "out-of-plane (y)")
+        .collect();
+    assert_eq!(closed.len(), 1, "{report:#}");
+    let omega = closed[0]["omega_rad_s"].as_f64().unwrap();
+    assert!(
+        (omega - pendulum).abs() < 1e-6 * pendulum,
+        "{omega} against {pendulum}"
+    );
+    assert!(closed[0]["growth"].as_f64().unwrap().abs() < 1e-6);
+}
+
+/// Hangprinter at the move's end: the locked reels' modes (eigenvalues of the closed-form
+/// stiffness) are the modes of the loop closed by the `length` controller holding its lengths
+/// (eigenvalues of that loop's finite-difference Jacobian) — two computations that share
+/// nothing but the robot; 1e-6 relative.
+#[test]
+fn locked_reel_modes_are_the_length_controlled_loops() {
+    let dir = TempDir::new("spatial-modes-locked");
+    let text = std::fs::read_to_string(example("hangprinter.toml"))
+        .unwrap()
+        .replace("kind = \"computed-torque\"", "kind = \"length\"");
+    let report = modes(&dir, &text, "0.1,0.05,0.02");
+    let omegas = |which: &str| -> Vec<f64> {
+        let mut v: Vec<f64> = report["modes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|m| m["linearisation"] == which && m["omega_rad_s"].as_f64().unwrap() > 0.0)
+            .map(|m| m["omega_rad_s"].as_f64().unwrap())
+            .collect();
+        v.sort_by(f64::total_cmp);
+        v
+    };
+    let (locked, closed) = (omegas("locked-reels"), omegas("closed"));
+    assert_eq!(locked.len(), 3);
+    assert_eq!(closed.len(), 3, "{report:#}");
+    for (a, b) in locked.iter().zip(&closed) {
+        assert!((a - b).abs() < 1e-6 * a, "{locked:?} against {closed:?}");
+    }
+}

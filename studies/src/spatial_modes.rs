@@ -1,0 +1,180 @@
+//! A spatial robot's modes at a pose (`cargo xtask modes --scenario FILE --at X,Y,Z`), each with
+//! its direction: the effector on its cables with the reels holding their tensions (the
+//! geometric stiffness Σ (T_i/l_i)(I − u_i u_iᵀ), MODELS.md §11), with the reels locked
+//! (K = Σ (EA/l_i) u_i u_iᵀ + (T_i/l_i) I), and in the scenario's closed loop (the elastic
+//! model and its controller, linearised by central differences at rest at the pose). The
+//! tensions at rest are the scenario's distribution of the weight there.
+
+use crate::{Result, StudyError};
+use cdpr_bench::analysis::linearise::closed_loop_jacobian;
+use cdpr_bench::core::closed_loop::ClosedLoop;
+use cdpr_bench::core::controller::TensionSolver;
+use cdpr_bench::core::robot::{Matrix, Robot, Vector};
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::elastic::Elastic;
+use cdpr_bench::numerics::eigen::mode_shapes;
+
+/// Which linearisation a mode is of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpatialLoop {
+    /// Open loop, reels holding their tensions (ideal tension control).
+    TensionReels,
+    /// Open loop, reels locked (lengths held).
+    LockedReels,
+    /// The scenario's controller closing the loop.
+    Closed,
+}
+
+/// One mode.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SpatialMode {
+    pub linearisation: SpatialLoop,
+    /// ω [rad/s] and growth σ [1/s] of λ = σ + iω.
+    pub omega_rad_s: f64,
+    pub growth: f64,
+    /// The effector's motion in the mode, unit length (zero for a mode of the controller's
+    /// states alone).
+    pub direction: [f64; 3],
+    /// "vertical (z)", "horizontal (x)", "horizontal (y)", "out-of-plane (y)" (two cables in
+    /// the plane y = const), or "controller".
+    pub name: String,
+}
+
+/// `modes.json`.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SpatialModes {
+    pub pose: [f64; 3],
+    /// The tensions at rest [N].
+    pub tensions: Vec<f64>,
+    pub modes: Vec<SpatialMode>,
+}
+
+/// The modes of `scenario`'s robot at rest at `pose` [m] (two cables: at rest at x = pose[0],
+/// the other coordinates found by the statics).
+pub fn at_pose(scenario: &Scenario, pose: [f64; 3]) -> Result<SpatialModes> {
+    let robot = cdpr_bench::prepare_spatial(scenario)?;
+    // The loop held at rest at the pose: a move of zero length (two cables: the paper's rule
+    // at x, the height and y its statics').
+    let mut closed_scenario = scenario.clone();
+    if robot.cables() > 2 {
+        closed_scenario.trajectory.start = Some(pose.to_vec());
+        closed_scenario.trajectory.end = Some(pose.to_vec());
+    } else {
+        closed_scenario.trajectory.x1 = pose[0];
+        closed_scenario.trajectory.x2 = pose[0];
+    }
+    closed_scenario.validate()?;
+    let ea = scenario.cable.axial_stiffness();
+    let mut sys = ClosedLoop::new(Elastic::new(robot, ea), &closed_scenario)
+        .map_err(cdpr_bench::Error::from)?;
+    let (y, eq) = sys.initial_state().map_err(cdpr_bench::Error::from)?;
+    let p = Vector::<3>::from_column_slice(&eq.state[..3]);
+    let pose = [p[0], p[1], p[2]];
+    let tensions = if robot.cables() > 2 {
+        TensionSolver::from(&scenario.controller).for_acceleration(&robot, &p, &Vector::zeros())
+    } else {
+        eq.tensions
+    };
+    let mut modes = Vec::new();
+    let mut geometric = Matrix::<3>::zeros();
+    let mut locked = Matrix::<3>::zeros();
+    for (i, t) in tensions.iter().enumerate() {
+        let c = robot.chord(i, &p);
+        let uu = c.direction * c.direction.transpose();
+        geometric += (Matrix::<3>::identity() - uu) * (t / c.length);
+        locked += uu * (ea / c.length) + Matrix::<3>::identity() * (t / c.length);
+    }
+    for (linearisation, k) in [
+        (SpatialLoop::TensionReels, geometric),
+        (SpatialLoop::LockedReels, locked),
+    ] {
+        let eigen = (k / robot.effector_mass).symmetric_eigen();
+        let mut pairs: Vec<(f64, Vector<3>)> = (0..3)
+            .map(|j| {
+                (
+                    eigen.eigenvalues[j],
+                    eigen.eigenvectors.column(j).into_owned(),
+                )
+            })
+            .collect();
+        pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (lambda, v) in pairs {
+            let direction = [v[0], v[1], v[2]];
+            modes.push(SpatialMode {
+                linearisation,
+                omega_rad_s: lambda.max(0.0).sqrt(),
+                growth: (-lambda).max(0.0).sqrt(),
+                name: name(&robot, direction),
+                direction,
+            });
+        }
+    }
+    let jacobian = closed_loop_jacobian(&mut sys, 0.0, &y);
+    let shapes = mode_shapes(&jacobian)
+        .map_err(|e| StudyError::Failed(format!("closed-loop modes at {pose:?} m: {e}")))?;
+    for shape in shapes {
+        // The effector's position components of the (complex) eigenvector, by magnitude.
+        let v = Vector::<3>::from_fn(|k, _| shape.vector[k].0.hypot(shape.vector[k].1));
+        let norm = v.norm();
+        let direction = if norm > 1e-6 {
+            let u = v / norm;
+            [u[0], u[1], u[2]]
+        } else {
+            [0.0; 3]
+        };
+        modes.push(SpatialMode {
+            linearisation: SpatialLoop::Closed,
+            omega_rad_s: shape.mode.omega,
+            growth: shape.mode.growth,
+            name: name(&robot, direction),
+            direction,
+        });
+    }
+    Ok(SpatialModes {
+        pose,
+        tensions: tensions.to_vec(),
+        modes,
+    })
+}
+
+/// A mode's name from its direction's dominant axis.
+fn name(robot: &Robot<3>, direction: [f64; 3]) -> String {
+    let [x, y, z] = direction.map(f64::abs);
+    if x.max(y).max(z) == 0.0 {
+        return "controller".into();
+    }
+    if z >= x && z >= y {
+        "vertical (z)".into()
+    } else if x >= y {
+        "horizontal (x)".into()
+    } else if robot.cables() == 2 {
+        "out-of-plane (y)".into()
+    } else {
+        "horizontal (y)".into()
+    }
+}
+
+/// The modes as a Markdown table.
+pub fn markdown(report: &SpatialModes) -> String {
+    let mut out = format!(
+        "Modes at ({}, {}, {}) m, tensions at rest {:?} N\n\n| linearisation | mode | ω [rad/s] | growth [1/s] | direction (x, y, z) |\n|---|---|---|---|---|\n",
+        report.pose[0], report.pose[1], report.pose[2], report.tensions
+    );
+    for m in &report.modes {
+        out += &format!(
+            "| {:?} | {} | {:.4} | {:.4e} | ({:.3}, {:.3}, {:.3}) |\n",
+            m.linearisation,
+            m.name,
+            m.omega_rad_s,
+            m.growth,
+            m.direction[0],
+            m.direction[1],
+            m.direction[2]
+        );
+    }
+    out += "\nDirections are the effector's part of each eigenvector, by magnitude; modes of one \
+            frequency repeated (a controller with equal gains on every axis) share their span, \
+            so their directions and names are any in it.\n";
+    out
+}
