@@ -215,3 +215,140 @@ fn the_gain_follows_widely_spread_weights() {
     ];
     check(weights, 0.6).unwrap();
 }
+
+/// The Hangprinter example's anchors [m] (examples/robots/hangprinter.toml).
+const HANGPRINTER: [[f64; 3]; 4] = [
+    [0.0, -1.61098, -0.13153],
+    [1.31422, 1.26814, -0.12128],
+    [-1.41573, 0.70761, -0.12182],
+    [0.0, 0.0, 2.29983],
+];
+
+/// The spatial LQR's gain K (m × 9, on (δp, δṗ, σ)) for the robot with `anchors`, an effector
+/// of mass M at the design point p, tensions at rest `hold`, weights Q = diag(qp I, qv I, qi I),
+/// R = r I (MODELS.md §11: M δp̈ = W δT + G δp, G = −Σ T_i (I − u_i u_iᵀ)/l_i).
+fn expected_spatial_gain(
+    anchors: &[[f64; 3]],
+    m: f64,
+    p: nalgebra::Vector3<f64>,
+    hold: &[f64],
+    weights: [f64; 4],
+) -> DMatrix<f64> {
+    let cables = anchors.len();
+    let mut a = DMatrix::zeros(9, 9);
+    let mut b = DMatrix::zeros(9, cables);
+    let mut stiffness = nalgebra::Matrix3::<f64>::zeros();
+    for (i, anchor) in anchors.iter().enumerate() {
+        let to_anchor = nalgebra::Vector3::from(*anchor) - p;
+        let (l, u) = (to_anchor.norm(), to_anchor / to_anchor.norm());
+        stiffness -= hold[i] * (nalgebra::Matrix3::identity() - u * u.transpose()) / l;
+        for k in 0..3 {
+            b[(3 + k, i)] = u[k] / m;
+        }
+    }
+    for i in 0..3 {
+        a[(i, 3 + i)] = 1.0;
+        a[(6 + i, i)] = 1.0;
+        for j in 0..3 {
+            a[(3 + i, j)] = stiffness[(i, j)] / m;
+        }
+    }
+    let [qp, qv, qi, r] = weights;
+    let diagonal: Vec<f64> = [qp, qv, qi].iter().flat_map(|&w| [w; 3]).collect();
+    let q = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(diagonal));
+    let r_matrix = DMatrix::identity(cables, cables) * r;
+    let x = care_by_sign(&a, &b, &q, &r_matrix);
+    let x = newton_refined(&a, &(&b * b.transpose() / r), &q, x);
+    b.transpose() * x / r
+}
+
+/// The QP's tensions holding M g at p for one degree of redundancy, computed here: on the line
+/// W⁺w + s n (n by cofactors; W⁺w ⟂ n) the s nearest 0 inside the box.
+fn one_redundancy_qp(
+    anchors: &[[f64; 3]],
+    m: f64,
+    g: f64,
+    p: nalgebra::Vector3<f64>,
+    (t_min, t_max): (f64, f64),
+) -> Vec<f64> {
+    let w = DMatrix::from_fn(3, anchors.len(), |k, i| {
+        let d = nalgebra::Vector3::from(anchors[i]) - p;
+        d[k] / d.norm()
+    });
+    let wrench = nalgebra::DVector::from_vec(vec![0.0, 0.0, m * g]);
+    let base = w.clone().pseudo_inverse(1e-14).unwrap() * &wrench;
+    // The null vector by cofactors: n_i = (−1)^i det(W without column i).
+    let null: Vec<f64> = (0..anchors.len())
+        .map(|i| {
+            let minor = w.clone().remove_column(i);
+            let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+            sign * minor.determinant()
+        })
+        .collect();
+    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+    for i in 0..anchors.len() {
+        let (x, y) = ((t_min - base[i]) / null[i], (t_max - base[i]) / null[i]);
+        lo = lo.max(x.min(y));
+        hi = hi.min(x.max(y));
+    }
+    assert!(lo <= hi, "the weight cannot be held in the box at {p}");
+    let s = 0.0f64.clamp(lo, hi);
+    (0..anchors.len()).map(|i| base[i] + s * null[i]).collect()
+}
+
+/// The spatial LQR (Hangprinter, 4 cables, designed at the move's end through the QP's tensions)
+/// reports the gain built here from the scenario's keys, over four decades of each weight.
+fn check_spatial(weights: [f64; 4], end: [f64; 3]) -> Result<(), TestCaseError> {
+    let [qp, qv, qi, r] = weights;
+    let anchors: Vec<String> = HANGPRINTER.iter().map(|a| format!("{a:?}")).collect();
+    let scenario = scenario_from_toml_str(&format!(
+        "[robot]\nanchors = [{}]\neffector_mass = 1.0\n[cable]\nyoungs_modulus = 2.105e10\n\
+         area = 9.503e-7\n[controller]\nkind = \"lqr\"\nt_min = 10.0\nt_max = 70.0\n\
+         q_position = {qp:e}\nq_velocity = {qv:e}\nq_integral = {qi:e}\nr = {r:e}\n\
+         [trajectory]\nstart = [0.0, 0.0, 0.0]\nend = {end:?}\nt2 = 1.0\n\
+         [simulation]\nt_final = 0.01\nsample_period = 1e-3\n",
+        anchors.join(", ")
+    ))
+    .unwrap();
+    let run = cdpr_bench::simulate_spatial(
+        &scenario,
+        &mut cdpr_bench::core::runner::Observer::progress(&mut |_| {}),
+    )
+    .unwrap()
+    .run;
+    let gains: std::collections::BTreeMap<_, _> = run.controller_gains.into_iter().collect();
+    prop_assert_eq!(&gains["lqr_design_point"], &end.to_vec());
+    let reported = DMatrix::from_row_slice(4, 9, &gains["lqr_gain"]);
+    let p = nalgebra::Vector3::from(end);
+    let hold = one_redundancy_qp(&HANGPRINTER, 1.0, 9.81, p, (10.0, 70.0));
+    let expected = expected_spatial_gain(&HANGPRINTER, 1.0, p, &hold, weights);
+    let error = (&reported - &expected).norm() / expected.norm();
+    prop_assert!(
+        error < 1e-9,
+        "weights {:?}: reported\n{}\nexpected\n{}\nrelative error {:e}",
+        weights,
+        reported,
+        expected,
+        error
+    );
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Hangprinter's LQR at two end poses (the example's, and one where another cable rests on
+    /// t_min), weights over four decades around the defaults.
+    #[test]
+    fn the_spatial_gain_follows_the_scenario_weights(
+        qp in 7.0..11.0f64,
+        qv in 2.0..6.0f64,
+        qi in 8.0..12.0f64,
+        r in -1.0..1.0f64,
+        other in any::<bool>(),
+    ) {
+        let weights = [10f64.powf(qp), 10f64.powf(qv), 10f64.powf(qi), 10f64.powf(r)];
+        let end = if other { [-0.2, 0.1, 0.3] } else { [0.1, 0.05, 0.02] };
+        check_spatial(weights, end)?;
+    }
+}
