@@ -54,7 +54,8 @@ pub use kind::ModelKind;
 pub use provenance::{Provenance, project_revision, revision};
 pub use spatial::{
     FEASIBILITY_SAMPLES, InfeasibleReference, SpatialRun, check_reference, prepare_spatial,
-    simulate_spatial, spatial_metrics,
+    prepare_spatial_start, simulate_spatial, simulate_spatial_into, spatial_channels,
+    spatial_metrics, spatial_metrics_of,
 };
 pub use study::{
     Assessed, EndAnalysis, Error, analyse, assess, assess_observed, assess_observed_into,

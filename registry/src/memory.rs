@@ -1,7 +1,7 @@
 //! What a run's samples and metrics need in memory, and what the machine has: the guard that
 //! refuses a run (or a sweep's worker count) before it starts rather than letting the OS kill it.
 
-use crate::build::{BuildError, build};
+use crate::build::build;
 use cdpr_analysis::metrics::memory_estimate;
 use cdpr_core::runner::channel_names;
 use cdpr_core::scenario::Scenario;
@@ -17,8 +17,12 @@ pub fn samples(scenario: &Scenario) -> f64 {
 
 /// Peak memory of a run of `scenario` and its metrics [B]
 /// ([`cdpr_analysis::metrics::memory_estimate`] for its samples and its model's channels).
-pub fn run_memory(scenario: &Scenario) -> Result<f64, BuildError> {
-    let channels = channel_names(&*build(scenario)?).len();
+pub fn run_memory(scenario: &Scenario) -> Result<f64, crate::Error> {
+    let channels = if scenario.robot.anchors.is_some() {
+        crate::spatial::spatial_channels(scenario)?
+    } else {
+        channel_names(&*build(scenario)?).len()
+    };
     Ok(memory_estimate(samples(scenario), channels))
 }
 

@@ -164,17 +164,45 @@ fn worst_cable(tensions: &[f64], limits: TensionBox) -> (usize, Bound) {
 
 /// Runs a spatial scenario, watched and steered by `observer`, and measures it.
 pub fn simulate_spatial(scenario: &Scenario, observer: &mut Observer) -> Result<SpatialRun, Error> {
-    let robot = prepare_spatial(scenario)?;
-    let model = Elastic::new(robot, scenario.cable.axial_stiffness());
-    let mut sys = ClosedLoop::new(model, scenario)?;
-    let run = simulate_observed_reusing(
-        &mut sys,
-        &RunOptions::from(scenario),
-        SeriesBuffer::default(),
-        observer,
-    )?;
+    simulate_spatial_into(scenario, observer, SeriesBuffer::default())
+}
+
+/// As [`simulate_spatial`], the samples written into `buffer`'s memory (a sweep's worker).
+pub fn simulate_spatial_into(
+    scenario: &Scenario,
+    observer: &mut Observer,
+    buffer: SeriesBuffer,
+) -> Result<SpatialRun, Error> {
+    let mut sys = spatial_loop(scenario)?;
+    let run = simulate_observed_reusing(&mut sys, &RunOptions::from(scenario), buffer, observer)?;
     let metrics = spatial_metrics(scenario, &sys, &run);
     Ok(SpatialRun { run, metrics })
+}
+
+/// The closed loop of a spatial scenario (checked by [`prepare_spatial`]).
+fn spatial_loop(scenario: &Scenario) -> Result<ClosedLoop<Elastic<3>, 3>, Error> {
+    let robot = prepare_spatial(scenario)?;
+    let model = Elastic::new(robot, scenario.cable.axial_stiffness());
+    Ok(ClosedLoop::new(model, scenario)?)
+}
+
+/// The metrics of `run` (e.g. the part a failed run sampled) of the spatial `scenario`.
+pub fn spatial_metrics_of(scenario: &Scenario, run: &Run) -> Result<SpatialMetrics, Error> {
+    Ok(spatial_metrics(scenario, &spatial_loop(scenario)?, run))
+}
+
+/// The spatial scenario ready to run: checked as [`prepare_spatial`] does, and its loop
+/// brought to rest at the start (a controller that cannot be designed, or a start the tensions
+/// do not hold, is refused here).
+pub fn prepare_spatial_start(scenario: &Scenario) -> Result<(), Error> {
+    spatial_loop(scenario)?.initial_state()?;
+    Ok(())
+}
+
+/// The number of channels of a spatial scenario's run.
+pub fn spatial_channels(scenario: &Scenario) -> Result<usize, Error> {
+    let sys = spatial_loop(scenario)?;
+    Ok(cdpr_core::runner::channel_names(&sys.model).len())
 }
 
 /// The metrics of a spatial run of `scenario` on the loop `sys`.

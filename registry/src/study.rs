@@ -366,6 +366,10 @@ pub fn resolve_shaper(scenario: &Scenario) -> Result<Scenario, Error> {
 /// set it, so a run that cannot start is refused before it writes anything. Returns the
 /// scenario with its shaper resolved (what the run then uses).
 pub fn prepare(scenario: &Scenario) -> Result<Scenario, Error> {
+    if scenario.robot.anchors.is_some() {
+        crate::spatial::prepare_spatial_start(scenario)?;
+        return Ok(scenario.clone());
+    }
     let resolved = resolve_shaper(scenario)?;
     let config = ModelConfig::from_scenario(&resolved)?;
     let start = |e| start_error(&resolved, &config, e);

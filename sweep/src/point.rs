@@ -173,7 +173,9 @@ pub fn describe(point: &Point) -> String {
         .join(", ")
 }
 
-/// Sets `section.key` (or deeper) in `table`; the key must name a section and a key in it.
+/// Sets `section.key` (or deeper) in `table`; the key must name a section and a key in it. An
+/// array element is named by 0-based indices after the key: `robot.anchors[3][2]` is the z of
+/// the fourth anchor, `trajectory.end[0]` the end's x (the array must be in the base scenario).
 fn set(table: &mut Table, dotted: &str, value: Value) -> Result<(), String> {
     let parts: Vec<&str> = dotted.split('.').collect();
     if parts.len() < 2 || parts.iter().any(|p| p.is_empty()) {
@@ -195,6 +197,49 @@ fn set(table: &mut Table, dotted: &str, value: Value) -> Result<(), String> {
             }
         };
     }
-    at.insert(parts[parts.len() - 1].to_string(), value);
+    let (name, indices) = indexed(dotted, parts[parts.len() - 1])?;
+    if indices.is_empty() {
+        at.insert(name.to_string(), value);
+        return Ok(());
+    }
+    let mut slot = at.get_mut(name).ok_or_else(|| {
+        format!(
+            "axis key `{dotted}`: `{name}` is not in the grid's scenario, so it has no elements"
+        )
+    })?;
+    for &k in &indices {
+        let Value::Array(items) = slot else {
+            return Err(format!("axis key `{dotted}`: `{slot}` is not an array"));
+        };
+        let len = items.len();
+        slot = items.get_mut(k).ok_or_else(|| {
+            format!("axis key `{dotted}`: index {k} outside an array of {len} (0-based)")
+        })?;
+    }
+    *slot = value;
     Ok(())
+}
+
+/// A key and its 0-based indices: `anchors[3][2]` → (`anchors`, [3, 2]).
+fn indexed<'a>(dotted: &str, part: &'a str) -> Result<(&'a str, Vec<usize>), String> {
+    let Some(open) = part.find('[') else {
+        return Ok((part, Vec::new()));
+    };
+    let (name, mut rest) = part.split_at(open);
+    let mut indices = Vec::new();
+    while !rest.is_empty() {
+        let index = rest
+            .strip_prefix('[')
+            .and_then(|r| r.split_once(']'))
+            .and_then(|(k, tail)| Some((k.parse::<usize>().ok()?, tail)));
+        let Some((k, tail)) = index else {
+            return Err(format!(
+                "axis key `{dotted}`: `{part}` must be a key followed by 0-based indices, \
+                 e.g. robot.anchors[3][2]"
+            ));
+        };
+        indices.push(k);
+        rest = tail;
+    }
+    Ok((name, indices))
 }

@@ -96,6 +96,15 @@ pub fn evaluate_into(
             }
             *buffer = assessed.run.series.into_buffer();
         }
+        Outcome::Spatial(metrics, t_reached, samples, error) => {
+            record.t_reached = t_reached;
+            record.metrics = metrics;
+            if let Some(e) = error {
+                record.status = "failed".into();
+                record.error = Some(e);
+            }
+            *buffer = samples;
+        }
         Outcome::Failed(e) => {
             record.status = "failed".into();
             record.error = Some(e);
@@ -109,6 +118,9 @@ pub fn evaluate_into(
 enum Outcome {
     /// The run, measured; with the error that stopped it early.
     Done(Box<Scenario>, Box<Assessed>, Option<String>),
+    /// A spatial robot's run: its metrics map, the time reached, the samples' memory and the
+    /// error that stopped it early.
+    Spatial(Map<String, Value>, f64, SeriesBuffer, Option<String>),
     /// Nothing to measure.
     Failed(String),
     Interrupted,
@@ -128,6 +140,9 @@ fn run(grid: &Grid, point: &Point, stop: Option<&AtomicBool>, buffer: SeriesBuff
         on_sample: None,
         stop,
     };
+    if scenario.robot.anchors.is_some() {
+        return run_spatial(scenario, &mut observer, buffer);
+    }
     match cdpr_bench::assess_observed_into(&scenario, &mut observer, buffer) {
         Ok(assessed) => Outcome::Done(Box::new(scenario), Box::new(assessed), None),
         Err(Error::Run(failure)) => match (failure.error, failure.partial) {
@@ -157,4 +172,39 @@ pub(crate) fn params(point: &Point) -> Map<String, Value> {
         .iter()
         .map(|(k, v)| (k.clone(), serde_json::to_value(v).unwrap_or(Value::Null)))
         .collect()
+}
+
+/// A spatial robot's point: its run with the spatial metrics (`simulate`'s metrics.json keys
+/// for a spatial robot), steps and RHS evaluations.
+fn run_spatial(scenario: Scenario, observer: &mut Observer, buffer: SeriesBuffer) -> Outcome {
+    let measured = |run: &cdpr_bench::core::runner::Run,
+                    metrics: &cdpr_bench::analysis::spatial::SpatialMetrics| {
+        let mut map = match serde_json::to_value(metrics) {
+            Ok(Value::Object(map)) => map,
+            _ => Map::new(),
+        };
+        map.insert("steps".into(), Value::from(run.stats.steps_accepted));
+        map.insert("rhs_evaluations".into(), Value::from(run.stats.rhs_evals));
+        map
+    };
+    match cdpr_bench::simulate_spatial_into(&scenario, observer, buffer) {
+        Ok(done) => {
+            let map = measured(&done.run, &done.metrics);
+            Outcome::Spatial(map, done.run.t_reached, done.run.series.into_buffer(), None)
+        }
+        Err(Error::Run(failure)) => match (failure.error, failure.partial) {
+            (RunError::Interrupted { .. }, _) => Outcome::Interrupted,
+            (error, Some(run)) => match cdpr_bench::spatial_metrics_of(&scenario, &run) {
+                Ok(metrics) => Outcome::Spatial(
+                    measured(&run, &metrics),
+                    run.t_reached,
+                    run.series.into_buffer(),
+                    Some(error.to_string()),
+                ),
+                Err(e) => Outcome::Failed(format!("{error}; its metrics: {e}")),
+            },
+            (error, None) => Outcome::Failed(error.to_string()),
+        },
+        Err(e) => Outcome::Failed(e.to_string()),
+    }
 }

@@ -378,3 +378,59 @@ proptest! {
         }
     }
 }
+
+/// A spatial robot swept over an array element: the height of Hangprinter's top anchor
+/// (`robot.anchors[3][2]`, 0-based) and the end's x (`trajectory.end[0]`). Each record is its
+/// scenario's own spatial run (the scenario built here by editing the anchors by hand), and the
+/// sweep's records equal across thread counts.
+#[test]
+fn spatial_points_sweep_array_elements() {
+    let text = r#"
+[scenario]
+robot = { anchors = [[0.0, -1.61098, -0.13153], [1.31422, 1.26814, -0.12128], [-1.41573, 0.70761, -0.12182], [0.0, 0.0, 2.29983]], effector_mass = 1.0 }
+cable = { youngs_modulus = 2.105e10, area = 9.503e-7 }
+controller = { kind = "computed-torque", t_min = 10.0, t_max = 70.0 }
+trajectory = { start = [0.0, 0.0, 0.0], end = [0.1, 0.05, 0.02], t2 = 0.2 }
+simulation = { t_final = 1.3, sample_period = 1e-3 }
+[axes]
+"robot.anchors[3][2]" = [1.8, 2.29983, 3.0]
+"trajectory.end[0]" = [0.05, 0.1]
+"#;
+    let g = Grid::from_toml_str(text, "test").unwrap();
+    assert_eq!(g.len(), 6);
+    let record = cdpr_sweep::evaluate(&g, 1, None).unwrap();
+    assert_eq!(record.status, "complete", "{:?}", record.error);
+    assert_eq!(record.params["robot.anchors[3][2]"], 1.8);
+    assert_eq!(record.params["trajectory.end[0]"], 0.1);
+    let scenario = cdpr_bench::scenario_from_toml_str(
+        "[robot]\nanchors = [[0.0, -1.61098, -0.13153], [1.31422, 1.26814, -0.12128], \
+         [-1.41573, 0.70761, -0.12182], [0.0, 0.0, 1.8]]\neffector_mass = 1.0\n\
+         [cable]\nyoungs_modulus = 2.105e10\narea = 9.503e-7\n\
+         [controller]\nkind = \"computed-torque\"\nt_min = 10.0\nt_max = 70.0\n\
+         [trajectory]\nstart = [0.0, 0.0, 0.0]\nend = [0.1, 0.05, 0.02]\nt2 = 0.2\n\
+         [simulation]\nt_final = 1.3\nsample_period = 1e-3\n",
+    )
+    .unwrap();
+    let own = cdpr_bench::simulate_spatial(
+        &scenario,
+        &mut cdpr_bench::core::runner::Observer::progress(&mut |_| {}),
+    )
+    .unwrap();
+    let own_metrics = serde_json::to_value(&own.metrics).unwrap();
+    for (key, value) in own_metrics.as_object().unwrap() {
+        assert_eq!(&record.metrics[key], value, "{key}");
+    }
+    assert_eq!(record.metrics["steps"], own.run.stats.steps_accepted);
+    let (one, two) = (tmp("spatial-1"), tmp("spatial-2"));
+    sweep(&g, &one, 1, Shard::ALL);
+    sweep(&g, &two, 2, Shard::ALL);
+    assert_eq!(
+        without_wall(&one.join(RESULTS)),
+        without_wall(&two.join(RESULTS))
+    );
+    let bad = Grid::from_toml_str(&text.replace("anchors[3][2]", "anchors[4][2]"), "test").unwrap();
+    let err = cdpr_sweep::point::scenario(&bad, &bad.point(0))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("index 4 outside an array of 4"), "{err}");
+}

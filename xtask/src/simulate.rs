@@ -130,7 +130,7 @@ pub fn prepare_out(out: &Path) -> Result<()> {
 
 /// Refuses a run whose samples and their metrics would take more than [`MEMORY_SHARE`] of the
 /// available memory, naming the estimate and the keys that set it.
-fn check_memory(scenario: &Scenario) -> Result<()> {
+pub(crate) fn check_memory(scenario: &Scenario) -> Result<()> {
     let sim = &scenario.simulation;
     let bytes = run_memory(scenario)?;
     if let Some(available) = available_memory()

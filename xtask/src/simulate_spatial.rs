@@ -5,11 +5,12 @@
 //! and reel speeds per cable).
 
 use crate::output::{Progress, write_json};
-use crate::simulate::{CsvStream, METRICS, PARTIAL, STOP, TIMESERIES, prepare_out, writable_out};
+use crate::simulate::{
+    CsvStream, METRICS, PARTIAL, STOP, TIMESERIES, check_memory, prepare_out, writable_out,
+};
 use anyhow::{Context, Result, bail};
 use cdpr_bench::analysis::spatial::SpatialMetrics;
 use cdpr_bench::core::channel::heading;
-use cdpr_bench::core::closed_loop::ClosedLoop;
 use cdpr_bench::core::runner::{Observer, RunError, channel_names, channel_units};
 use cdpr_bench::core::scenario::Scenario;
 use cdpr_bench::{Error, Provenance, SpatialRun};
@@ -36,6 +37,9 @@ struct SpatialMetricsFile<'a> {
 
 /// Runs the spatial `scenario` into `out`, every `every`-th sample written.
 pub fn run(scenario: &Scenario, out: &Path, every: usize) -> Result<()> {
+    // What can be known before the run (the reference's feasibility, the start, the
+    // controller's design): refused here, before anything is written.
+    cdpr_bench::prepare(scenario)?;
     let robot = cdpr_bench::prepare_spatial(scenario)?;
     let provenance = Provenance::of(scenario)?;
     writable_out(out)?;
@@ -47,8 +51,7 @@ pub fn run(scenario: &Scenario, out: &Path, every: usize) -> Result<()> {
         .zip(channel_units(&model))
         .map(|(name, unit)| heading(name, unit))
         .collect();
-    // Built here too, so that a controller that cannot be designed fails before any file.
-    ClosedLoop::new(model, scenario).map_err(Error::from)?;
+    check_memory(scenario)?;
     ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
         .context("installing the SIGINT/SIGTERM handler")?;
     let mut stream = CsvStream::create(out.join(PARTIAL), &headings, every)?;
@@ -74,11 +77,7 @@ pub fn run(scenario: &Scenario, out: &Path, every: usize) -> Result<()> {
             };
             let error = write_failure.unwrap_or_else(|| failure.error.to_string());
             let done = failure.partial.map(|run| {
-                let model =
-                    cdpr_bench::elastic::Elastic::new(robot, scenario.cable.axial_stiffness());
-                let metrics = ClosedLoop::new(model, scenario)
-                    .map(|sys| cdpr_bench::spatial_metrics(scenario, &sys, &run))
-                    .ok();
+                let metrics = cdpr_bench::spatial_metrics_of(scenario, &run).ok();
                 (run, metrics)
             });
             match done {
