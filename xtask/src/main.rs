@@ -20,6 +20,7 @@ mod report;
 mod shaping;
 mod simulate;
 mod simulate_spatial;
+mod spatial_figures;
 mod spatial_moves;
 mod statics_sweep;
 mod sweep;

@@ -2,7 +2,7 @@
 //! planar run — checked before work (here also the whole reference's wrench feasibility), `--out`
 //! locked, samples streamed to `timeseries.partial.csv`, SIGINT/SIGTERM honoured, always a
 //! `metrics.json` saying how the run ended — with the spatial metrics (3-D path error, tensions
-//! and reel speeds per cable).
+//! and reel speeds per cable) and two figures: the path in three projections, the tensions.
 
 use crate::output::{Progress, write_json};
 use crate::simulate::{
@@ -112,6 +112,7 @@ pub fn run(scenario: &Scenario, out: &Path, every: usize) -> Result<()> {
     )?;
     written?;
     if let Some(d) = &done {
+        crate::spatial_figures::write(scenario, &d.run, out)?;
         println!(
             "elastic in space, {} cables: {} samples, {} RHS evaluations, {} accepted steps; path error during the move {:.3e} m, 1 s after {:.3e} m → {}",
             d.metrics.cables,

@@ -44,6 +44,10 @@ fn hangprinter_move_writes_a_consistent_record() {
         serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
     assert_eq!(metrics["status"], "complete");
     assert_eq!(metrics["cables"], 4);
+    for figure in ["path.svg", "path.png", "tensions.svg", "tensions.png"] {
+        let bytes = std::fs::metadata(out.join(figure)).map_or(0, |m| m.len());
+        assert!(bytes > 1000, "{figure}: {bytes} B");
+    }
     assert!(metrics["path_err_max_move"].as_f64().unwrap() < 1e-6);
     let text = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
     let mut lines = text.lines();
