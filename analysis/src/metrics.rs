@@ -311,6 +311,58 @@ fn peak_omega(p: Result<Peak, NoPeak>) -> f64 {
     p.map_or(f64::NAN, |p| p.omega)
 }
 
+/// The spectra of a run: the settled window's z and error (only where the window is long enough
+/// to be read; none below) and the whole record's z.
+struct Spectra {
+    z: SettledPeaks,
+    err: SettledPeaks,
+    whole: Result<Peak, NoPeak>,
+}
+
+impl Spectra {
+    fn of(
+        z: &[f64],
+        err: &[f64],
+        spectral: std::ops::Range<usize>,
+        long_enough: bool,
+        t_end: f64,
+        dt: f64,
+        resolution: f64,
+    ) -> Self {
+        let (z_spec, err_spec) = if long_enough {
+            (
+                SettledPeaks::new(&z[spectral.clone()], dt, 0, resolution),
+                SettledPeaks::new(&err[spectral], dt, HF_PEAKS, resolution),
+            )
+        } else {
+            (SettledPeaks::none(), SettledPeaks::none())
+        };
+        let whole = if t_end >= MIN_SPECTRAL_WINDOW {
+            let p2p = peak_to_peak(z);
+            if p2p < resolution {
+                Err(NoPeak::Unresolved { p2p, resolution })
+            } else {
+                Spectrum::new(z, dt, Window::Rectangular).max_bin_peak(0.0)
+            }
+        } else {
+            Err(NoPeak::Empty)
+        };
+        Self {
+            z: z_spec,
+            err: err_spec,
+            whole,
+        }
+    }
+}
+
+/// The level of peak `p` relative to the error's main peak [dB] (NaN without one).
+fn db(p: &Peak, main: Result<Peak, NoPeak>) -> f64 {
+    match main {
+        Ok(main) => 20.0 * (p.amplitude / main.amplitude).log10(),
+        Err(_) => f64::NAN,
+    }
+}
+
 /// The spectral peaks of one signal over the settled window: the plain peak (rectangular
 /// window, no padding), the refined peak (Hann, [`PAD`]× padding, ω ≥ [`REFINED_FROM`]) and,
 /// for `hf` > 0, the largest local maxima of the refined spectrum above [`HF_FROM`].
@@ -402,40 +454,19 @@ impl Metrics {
         let zs = &z[settled.clone()];
         let z_p2p = peak_to_peak(zs);
 
-        // The spectra only where their windows are long enough to be read (else null below).
         let long_enough = t_end - settled_start >= MIN_SPECTRAL_WINDOW;
-        let (z_spec, err_spec) = if long_enough {
-            (
-                SettledPeaks::new(&z[spectral.clone()], dt, 0, context.resolution),
-                SettledPeaks::new(&err[spectral], dt, HF_PEAKS, context.resolution),
-            )
-        } else {
-            (SettledPeaks::none(), SettledPeaks::none())
-        };
-        let whole = if t_end >= MIN_SPECTRAL_WINDOW {
-            let p2p = peak_to_peak(z);
-            if p2p < context.resolution {
-                Err(NoPeak::Unresolved {
-                    p2p,
-                    resolution: context.resolution,
-                })
-            } else {
-                Spectrum::new(z, dt, Window::Rectangular).max_bin_peak(0.0)
-            }
-        } else {
-            Err(NoPeak::Empty)
-        };
+        let Spectra {
+            z: z_spec,
+            err: err_spec,
+            whole,
+        } = Spectra::of(z, err, spectral, long_enough, t_end, dt, context.resolution);
         let err_main = err_spec.refined;
-        let db = |p: &Peak| match err_main {
-            Ok(main) => 20.0 * (p.amplitude / main.amplitude).log10(),
-            Err(_) => f64::NAN,
-        };
         let err_hf = err_spec.high_frequency.first().copied();
-        let err_hf_peak_db = err_hf.as_ref().map_or(f64::NAN, db);
+        let err_hf_peak_db = err_hf.as_ref().map_or(f64::NAN, |p| db(p, err_main));
         let err_hf_peaks = err_spec
             .high_frequency
             .iter()
-            .map(|p| [p.omega, db(p)])
+            .map(|p| [p.omega, db(p, err_main)])
             .collect();
 
         let further_cables = c.tensions[c.tensions.len().min(2)..]
@@ -508,6 +539,28 @@ impl Metrics {
     /// Sets to NaN, with the reason, every metric whose window the run does not reach or fill,
     /// and says why each peak that is null has none.
     fn mark_unavailable(&mut self, spectra: bool) {
+        let (t_end, move_end) = (self.windows.record[1], self.windows.transition[1]);
+        let mut unavailable = self.window_reasons();
+        unavailable.extend(self.spectral_reasons(spectra));
+        self.control
+            .mark_unavailable(move_end, t_end, &mut unavailable);
+        for (key, why) in unavailable {
+            if !self.set_nan(key) {
+                continue;
+            }
+            self.unavailable.entry(key.to_owned()).or_insert(why);
+        }
+        if self.z_fft_record_rad_s.is_nan() {
+            self.z_fft_record_bin = 0;
+        }
+        if self.err_hf_peak_rad_s.is_nan() {
+            self.err_hf_peaks.clear();
+        }
+    }
+
+    /// The metrics whose time windows the record does not reach or fill, and why (the further
+    /// cables' last-second means are set NaN here).
+    fn window_reasons(&mut self) -> Vec<(&'static str, String)> {
         let w = self.windows;
         let t_end = w.record[1];
         let move_end = w.transition[1];
@@ -555,6 +608,15 @@ impl Metrics {
                 self.unavailable.entry(key).or_insert_with(|| why.clone());
             }
         }
+        unavailable
+    }
+
+    /// The spectral metrics the record cannot give, and why (`spectra`: the settled window is
+    /// long enough to be read).
+    fn spectral_reasons(&self, spectra: bool) -> Vec<(&'static str, String)> {
+        let w = self.windows;
+        let t_end = w.record[1];
+        let mut unavailable: Vec<(&'static str, String)> = Vec::new();
         let spectral = [
             ("z_peak_rad_s", "z", "refined"),
             ("err_peak_rad_s", "the error", "refined"),
@@ -605,20 +667,7 @@ impl Metrics {
             let why = format!("z has no plain spectral peak over the record: {why}");
             unavailable.push(("z_fft_record_rad_s", why));
         }
-        self.control
-            .mark_unavailable(move_end, t_end, &mut unavailable);
-        for (key, why) in unavailable {
-            if !self.set_nan(key) {
-                continue;
-            }
-            self.unavailable.entry(key.to_owned()).or_insert(why);
-        }
-        if self.z_fft_record_rad_s.is_nan() {
-            self.z_fft_record_bin = 0;
-        }
-        if self.err_hf_peak_rad_s.is_nan() {
-            self.err_hf_peaks.clear();
-        }
+        unavailable
     }
 
     /// Sets the metric `key` to NaN; false for a key that is none of these.

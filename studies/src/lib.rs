@@ -21,6 +21,7 @@ pub mod control;
 pub mod distribution;
 pub mod modes;
 pub mod paper;
+pub mod paper_report;
 pub mod pool;
 pub mod samples;
 pub mod shaping;

@@ -193,6 +193,14 @@ impl ModesReport {
         w: &mut dyn Write,
         peaks: &[(&str, f64, f64)],
     ) -> std::io::Result<()> {
+        self.write_intro(w, peaks)?;
+        self.write_key_modes(w)?;
+        self.write_figure_links(w)?;
+        self.write_damping(w)
+    }
+
+    /// What the table holds and how it was made; the runs' FFT peaks.
+    fn write_intro(&self, w: &mut dyn Write, peaks: &[(&str, f64, f64)]) -> std::io::Result<()> {
         writeln!(
             w,
             "Every eigenvalue λ = σ + iω of the linearised loop (model + PID + tension distribution, \
@@ -219,51 +227,18 @@ impl ModesReport {
                     .join("; ")
             )?;
         }
+        Ok(())
+    }
+
+    /// The key modes of every analysis, with their references.
+    fn write_key_modes(&self, w: &mut dyn Write) -> std::io::Result<()> {
         writeln!(
             w,
             "| model | x [m] | loop | mode | ω [rad/s] | σ [1/s] | ζ | purity | reference [rad/s] |"
         )?;
         writeln!(w, "|---|---|---|---|---|---|---|---|---|")?;
         for a in &self.analyses {
-            let eq15 = cdpr_bench::elastic::eq15_frequency(
-                0.5 * (a.tensions[0] + a.tensions[1]),
-                self.effector_mass,
-                a.x,
-                self.anchor_distance,
-            );
-            let mut rows: Vec<(String, &ClassifiedMode, String)> = Vec::new();
-            if let Some(m) = a.vertical() {
-                rows.push(("vertical".into(), m, format!("eq. 15: {eq15:.4}")));
-            }
-            for m in a.modes.iter().filter(|m| m.kind == ModeKind::Horizontal) {
-                rows.push((m.kind.to_string(), m, String::new()));
-            }
-            let transverse = a
-                .modes
-                .iter()
-                .filter(|m| matches!(m.kind, ModeKind::Transverse(_)));
-            for (rank, m) in transverse.take(2).enumerate() {
-                if let Some((cable, k, t)) = self.taut_string(a, m) {
-                    rows.push((
-                        format!("transverse #{} ({})", rank + 1, m.kind),
-                        m,
-                        format!("taut string cable {}, k = {k}: {t:.3}", cable + 1),
-                    ));
-                }
-            }
-            for cable in 0..2 {
-                if let Some(m) = a.find(ModeKind::Axial(cable), 1) {
-                    rows.push((
-                        format!("lowest axial, cable {}", cable + 1),
-                        m,
-                        String::new(),
-                    ));
-                }
-            }
-            if let Some(m) = a.least_stable() {
-                rows.push((format!("**least stable** ({})", m.kind), m, String::new()));
-            }
-            for (kind, m, reference) in rows {
+            for (kind, m, reference) in self.key_modes(a) {
                 writeln!(
                     w,
                     "| {} | {} | {} | {} | {:.4} | {:+.4e} | {:.3e} | {:.3} | {} |",
@@ -279,6 +254,55 @@ impl ModesReport {
                 )?;
             }
         }
+        Ok(())
+    }
+
+    /// The rows of one analysis: the vertical mode against eq. 15, the horizontal, the two
+    /// lowest transverse against the taut string, each cable's lowest axial, the least stable.
+    fn key_modes<'a>(&self, a: &'a Analysis) -> Vec<(String, &'a ClassifiedMode, String)> {
+        let eq15 = cdpr_bench::elastic::eq15_frequency(
+            0.5 * (a.tensions[0] + a.tensions[1]),
+            self.effector_mass,
+            a.x,
+            self.anchor_distance,
+        );
+        let mut rows: Vec<(String, &ClassifiedMode, String)> = Vec::new();
+        if let Some(m) = a.vertical() {
+            rows.push(("vertical".into(), m, format!("eq. 15: {eq15:.4}")));
+        }
+        for m in a.modes.iter().filter(|m| m.kind == ModeKind::Horizontal) {
+            rows.push((m.kind.to_string(), m, String::new()));
+        }
+        let transverse = a
+            .modes
+            .iter()
+            .filter(|m| matches!(m.kind, ModeKind::Transverse(_)));
+        for (rank, m) in transverse.take(2).enumerate() {
+            if let Some((cable, k, t)) = self.taut_string(a, m) {
+                rows.push((
+                    format!("transverse #{} ({})", rank + 1, m.kind),
+                    m,
+                    format!("taut string cable {}, k = {k}: {t:.3}", cable + 1),
+                ));
+            }
+        }
+        for cable in 0..2 {
+            if let Some(m) = a.find(ModeKind::Axial(cable), 1) {
+                rows.push((
+                    format!("lowest axial, cable {}", cable + 1),
+                    m,
+                    String::new(),
+                ));
+            }
+        }
+        if let Some(m) = a.least_stable() {
+            rows.push((format!("**least stable** ({})", m.kind), m, String::new()));
+        }
+        rows
+    }
+
+    /// Links to each position's spectrum figure.
+    fn write_figure_links(&self, w: &mut dyn Write) -> std::io::Result<()> {
         let xs = self.positions();
         writeln!(w)?;
         for x in xs {
@@ -287,6 +311,11 @@ impl ModesReport {
                 "![Closed-loop modes at x = {x}: |λ| vs ζ](modes_x{x}.svg)\n\nPNG: [modes_x{x}.png](modes_x{x}.png)\n"
             )?;
         }
+        Ok(())
+    }
+
+    /// The damping sweep's answer per model and position.
+    fn write_damping(&self, w: &mut dyn Write) -> std::io::Result<()> {
         writeln!(w, "### Axial damping that makes every mode decay\n")?;
         for s in &self.sweeps {
             let at = match s.smallest {

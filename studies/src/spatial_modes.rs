@@ -76,15 +76,27 @@ pub fn at_pose(scenario: &Scenario, pose: [f64; 3]) -> Result<SpatialModes> {
     } else {
         eq.tensions
     };
-    let mut modes = Vec::new();
+    let mut modes = open_loop_modes(&robot, &p, &tensions, ea);
+    modes.extend(closed_loop_modes(&mut sys, &y, &robot, pose)?);
+    Ok(SpatialModes {
+        pose,
+        tensions: tensions.to_vec(),
+        modes,
+    })
+}
+
+/// The effector's modes on its cables with the reels holding `tensions` (the geometric
+/// stiffness) and with the reels locked, from the closed-form stiffness matrices.
+fn open_loop_modes(robot: &Robot<3>, p: &Vector<3>, tensions: &[f64], ea: f64) -> Vec<SpatialMode> {
     let mut geometric = Matrix::<3>::zeros();
     let mut locked = Matrix::<3>::zeros();
     for (i, t) in tensions.iter().enumerate() {
-        let c = robot.chord(i, &p);
+        let c = robot.chord(i, p);
         let uu = c.direction * c.direction.transpose();
         geometric += (Matrix::<3>::identity() - uu) * (t / c.length);
         locked += uu * (ea / c.length) + Matrix::<3>::identity() * (t / c.length);
     }
+    let mut modes = Vec::new();
     for (linearisation, k) in [
         (SpatialLoop::TensionReels, geometric),
         (SpatialLoop::LockedReels, locked),
@@ -105,37 +117,45 @@ pub fn at_pose(scenario: &Scenario, pose: [f64; 3]) -> Result<SpatialModes> {
                 linearisation,
                 omega_rad_s: lambda.max(0.0).sqrt(),
                 growth: (-lambda).max(0.0).sqrt(),
-                name: name(&robot, direction),
+                name: name(robot, direction),
                 direction,
             });
         }
     }
-    let jacobian = closed_loop_jacobian(&mut sys, 0.0, &y);
+    modes
+}
+
+/// The closed loop's modes at its rest state `y`, from its finite-difference Jacobian.
+fn closed_loop_modes(
+    sys: &mut ClosedLoop<Elastic<3>, 3>,
+    y: &[f64],
+    robot: &Robot<3>,
+    pose: [f64; 3],
+) -> Result<Vec<SpatialMode>> {
+    let jacobian = closed_loop_jacobian(sys, 0.0, y);
     let shapes = mode_shapes(&jacobian)
         .map_err(|e| StudyError::Failed(format!("closed-loop modes at {pose:?} m: {e}")))?;
-    for shape in shapes {
-        // The effector's position components of the (complex) eigenvector, by magnitude.
-        let v = Vector::<3>::from_fn(|k, _| shape.vector[k].0.hypot(shape.vector[k].1));
-        let norm = v.norm();
-        let direction = if norm > 1e-6 {
-            let u = v / norm;
-            [u[0], u[1], u[2]]
-        } else {
-            [0.0; 3]
-        };
-        modes.push(SpatialMode {
-            linearisation: SpatialLoop::Closed,
-            omega_rad_s: shape.mode.omega,
-            growth: shape.mode.growth,
-            name: name(&robot, direction),
-            direction,
-        });
-    }
-    Ok(SpatialModes {
-        pose,
-        tensions: tensions.to_vec(),
-        modes,
-    })
+    Ok(shapes
+        .into_iter()
+        .map(|shape| {
+            // The effector's position components of the (complex) eigenvector, by magnitude.
+            let v = Vector::<3>::from_fn(|k, _| shape.vector[k].0.hypot(shape.vector[k].1));
+            let norm = v.norm();
+            let direction = if norm > 1e-6 {
+                let u = v / norm;
+                [u[0], u[1], u[2]]
+            } else {
+                [0.0; 3]
+            };
+            SpatialMode {
+                linearisation: SpatialLoop::Closed,
+                omega_rad_s: shape.mode.omega,
+                growth: shape.mode.growth,
+                name: name(robot, direction),
+                direction,
+            }
+        })
+        .collect())
 }
 
 /// A mode's name from its direction's dominant axis.

@@ -18,6 +18,7 @@ use cdpr_bench::core::scenario::Scenario;
 use cdpr_bench::core::trajectory::Step5;
 use cdpr_bench::numerics::eigen::Mode;
 use cdpr_studies::paper::PaperRuns;
+use cdpr_studies::paper_report::{self, ReportInputs};
 use cdpr_verify::acceptance::Check;
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
@@ -38,11 +39,6 @@ struct ModelEntry<'a> {
     vertical_mode: Mode,
     x2_effector_z: f64,
     x2_force: f64,
-}
-
-/// A Markdown table cell: `|` (as in "max |error|") would end the cell.
-fn cell(text: &str) -> String {
-    text.replace('|', "\\|")
 }
 
 fn bars(kinds: &[ModelKind]) -> (MultiProgress, Vec<ProgressBar>) {
@@ -194,100 +190,130 @@ fn write_figures(
 ) -> Result<Vec<(String, String)>> {
     let c = curves(outcomes);
     let t_end = base.simulation.t_final;
-    let dt = base.simulation.sample_period;
     let step5 = Step5::from(&base.trajectory);
     let settled_from = Windows::new(step5.t1, step5.t2, t_end).settled_start();
-    let black = RGBColor(0, 0, 0);
-    let panel = |x: &str, y: &str, lines: Vec<Line>, markers: Vec<Marker>, log_y: bool| Panel {
+    let figures_out = [
+        fig5_position(&c, outcomes, t_end),
+        fig6_error(&c, t_end),
+        fig7_spectrum(&c, settled_from, base.simulation.sample_period, eq15),
+        fig8_tensions(&c, base.trajectory.t2, t_end),
+        step5_reference(&step5),
+    ];
+    let mut names = Vec::new();
+    for f in &figures_out {
+        figures::render(f, out)?;
+        names.push((f.name.clone(), f.title.clone()));
+    }
+    Ok(names)
+}
+
+/// A panel on a linear time axis (log y where asked).
+fn panel(x: &str, y: &str, lines: Vec<Line>, markers: Vec<Marker>, log_y: bool) -> Panel {
+    Panel {
         x_label: x.into(),
         y_label: y.into(),
         log_x: false,
         log_y,
         lines,
         markers,
-    };
-    let mut x_lines = lines(&c, |r| figures::channel(r, Channel::X, 0.0, t_end, 1.0));
+    }
+}
+
+const BLACK: RGBColor = RGBColor(0, 0, 0);
+
+/// Fig. 5: x (with the reference) and z of every model.
+fn fig5_position(c: &[Curve], outcomes: &[Outcome], t_end: f64) -> Figure {
+    let mut x_lines = lines(c, |r| figures::channel(r, Channel::X, 0.0, t_end, 1.0));
     if let Some(first) = outcomes.first() {
         x_lines.push(Line {
             label: "x_ref (step5)".into(),
-            color: black,
+            color: BLACK,
             dashed: true,
             width: figures::LINE_WIDTH,
             points: figures::channel(&first.run, Channel::XRef, 0.0, t_end, 1.0),
         });
     }
-    let mut figures_out = vec![
-        Figure {
-            name: "fig5_position".into(),
-            title: "Fig. 5: effector position x and z".into(),
-            panels: vec![
-                panel("t [s]", "x [m]", x_lines, vec![], false),
-                panel(
-                    "t [s]",
-                    "z [mm]",
-                    lines(&c, |r| figures::channel(r, Channel::Z, 0.0, t_end, 1e3)),
-                    vec![],
-                    false,
-                ),
-            ],
-        },
-        Figure {
-            name: "fig6_error".into(),
-            title: "Fig. 6: position error x_ref − x".into(),
-            panels: vec![
-                panel(
-                    "t [s]",
-                    "error [mm]",
-                    lines(&c, |r| figures::channel(r, Channel::Error, 0.0, t_end, 1e3)),
-                    vec![],
-                    false,
-                ),
-                panel(
-                    "t [s]",
-                    "|error| [m]",
-                    lines(&c, |r| figures::channel(r, Channel::Error, 0.0, t_end, 1.0)),
-                    vec![
-                        Marker::Horizontal(1e-5, "1e-5 m (paper: after 1 s)".into()),
-                        Marker::Vertical(1.0, "t = 1 s".into()),
-                    ],
-                    true,
-                ),
-            ],
-        },
-    ];
+    Figure {
+        name: "fig5_position".into(),
+        title: "Fig. 5: effector position x and z".into(),
+        panels: vec![
+            panel("t [s]", "x [m]", x_lines, vec![], false),
+            panel(
+                "t [s]",
+                "z [mm]",
+                lines(c, |r| figures::channel(r, Channel::Z, 0.0, t_end, 1e3)),
+                vec![],
+                false,
+            ),
+        ],
+    }
+}
+
+/// Fig. 6: the error, linear and on a log scale against the paper's 1e-5 m after 1 s.
+fn fig6_error(c: &[Curve], t_end: f64) -> Figure {
+    Figure {
+        name: "fig6_error".into(),
+        title: "Fig. 6: position error x_ref − x".into(),
+        panels: vec![
+            panel(
+                "t [s]",
+                "error [mm]",
+                lines(c, |r| figures::channel(r, Channel::Error, 0.0, t_end, 1e3)),
+                vec![],
+                false,
+            ),
+            panel(
+                "t [s]",
+                "|error| [m]",
+                lines(c, |r| figures::channel(r, Channel::Error, 0.0, t_end, 1.0)),
+                vec![
+                    Marker::Horizontal(1e-5, "1e-5 m (paper: after 1 s)".into()),
+                    Marker::Vertical(1.0, "t = 1 s".into()),
+                ],
+                true,
+            ),
+        ],
+    }
+}
+
+/// Fig. 7: amplitude spectra of the error and of z over the settled window, eq. 15 marked.
+fn fig7_spectrum(c: &[Curve], settled_from: f64, dt: f64, eq15: f64) -> Figure {
     let spectrum_panel = |channel: Channel, label: &str| Panel {
         x_label: "ω [rad/s]".into(),
         y_label: label.into(),
         log_x: true,
         log_y: true,
-        lines: lines(&c, |r| {
+        lines: lines(c, |r| {
             figures::spectrum(r, channel, settled_from, dt, (1.0, 2.0e5))
         }),
         markers: vec![Marker::Vertical(eq15, format!("eq. 15: {eq15:.2} rad/s"))],
     };
-    figures_out.push(Figure {
+    Figure {
         name: "fig7_spectrum".into(),
         title: "Fig. 7: amplitude spectra over [1, 5] s (Hann window, 16× zero padding)".into(),
         panels: vec![
             spectrum_panel(Channel::Error, "|error| amplitude [m]"),
             spectrum_panel(Channel::Z, "|z| amplitude [m]"),
         ],
-    });
-    let t2 = base.trajectory.t2;
+    }
+}
+
+/// Fig. 8: T1 (solid) and T2 (dashed) in the transition and settling, the paper's values marked.
+fn fig8_tensions(c: &[Curve], t2: f64, t_end: f64) -> Figure {
     let tensions = |t0: f64, t1: f64| {
-        let mut v = lines(&c, |r| figures::channel(r, Channel::T1, t0, t1, 1.0));
-        for (line, curve) in v.iter_mut().zip(&c) {
+        let mut v = lines(c, |r| figures::channel(r, Channel::T1, t0, t1, 1.0));
+        for (line, curve) in v.iter_mut().zip(c) {
             line.label = format!("T1 {}", curve.label);
         }
-        let mut t2_lines = lines(&c, |r| figures::channel(r, Channel::T2, t0, t1, 1.0));
-        for (line, curve) in t2_lines.iter_mut().zip(&c) {
+        let mut t2_lines = lines(c, |r| figures::channel(r, Channel::T2, t0, t1, 1.0));
+        for (line, curve) in t2_lines.iter_mut().zip(c) {
             line.label = format!("T2 {}", curve.label);
             line.dashed = true;
         }
         v.extend(t2_lines);
         v
     };
-    figures_out.push(Figure {
+    Figure {
         name: "fig8_tensions".into(),
         title: "Fig. 8: commanded cable tensions (T1 solid, T2 dashed)".into(),
         panels: vec![
@@ -309,19 +335,23 @@ fn write_figures(
                 false,
             ),
         ],
-    });
-    let [xs, vs, accs] = figures::step5_lines(&step5);
+    }
+}
+
+/// The step5 reference with its analytic maximum speed and acceleration.
+fn step5_reference(step5: &Step5) -> Figure {
+    let [xs, vs, accs] = figures::step5_lines(step5);
     let [ta, tb] = step5.max_acceleration_times();
     let reference = |label: &str, points| {
         vec![Line {
             label: label.into(),
-            color: black,
+            color: BLACK,
             dashed: false,
             width: figures::LINE_WIDTH,
             points,
         }]
     };
-    figures_out.push(Figure {
+    Figure {
         name: "step5_reference".into(),
         title: "step5 reference (eq. 13) with its analytic maxima".into(),
         panels: vec![
@@ -352,13 +382,7 @@ fn write_figures(
                 false,
             ),
         ],
-    });
-    let mut names = Vec::new();
-    for f in &figures_out {
-        figures::render(f, out)?;
-        names.push((f.name.clone(), f.title.clone()));
     }
-    Ok(names)
 }
 
 /// The git revision of the project this binary was built from (wherever it runs), marked when
@@ -393,178 +417,24 @@ fn write_markdown(
     control: &str,
     out: &Path,
 ) -> Result<()> {
-    let sim = &base.simulation;
-    let passed = checks.iter().filter(|c| c.pass).count();
-    write_atomic(&out.join("REPORT.md"), |w| {
-        writeln!(w, "# cdpr-bench reproduction report\n")?;
-        writeln!(
-            w,
-            "The paper's scenario (MODELS.md §1) with every available cable model: DOPRI5, rtol {:e}, atol {:e}, \
-             samples every {:e} s over {} s. Regenerate with `cargo xtask report`.\n",
-            sim.rtol, sim.atol, sim.sample_period, sim.t_final
-        )?;
-        writeln!(
-            w,
-            "**{passed} of {} checks of MODELS.md §8 pass.**",
-            checks.len()
-        )?;
-        writeln!(w)?;
-        writeln!(
-            w,
-            "## MODELS.md §8: the paper's results, ours, the tolerance\n"
-        )?;
-        writeln!(w, "| quantity | model | paper | ours | accept | pass |")?;
-        writeln!(w, "|---|---|---|---|---|---|")?;
-        for c in checks {
-            let mark = if c.pass { "✅" } else { "❌" };
-            let cells = [&c.quantity, &c.model, &c.paper, &c.ours, &c.accept].map(|s| cell(s));
-            writeln!(w, "| {} | {mark} |", cells.join(" | "))?;
-        }
-
-        writeln!(w, "\n## Vertical frequency of the effector\n")?;
-        writeln!(
-            w,
-            "Eq. 15 (two strings and a mass, tension ΣT/2) at x = {}: **{eq15:.4} rad/s** (paper: 20.41). The \
-             closed-loop eigenfrequency comes from the finite-difference Jacobian of model + PID + tension \
-             distribution at the static equilibrium at x2; the refined peaks from the Hann-windowed, 16× padded \
-             spectrum over [1, 5] s; the plain peak is the FFT bin of the 5 s record that the paper reports \
-             (20.11 rad/s = bin 16, 2π·16/5).\n",
-            base.trajectory.x2
-        )?;
-        writeln!(
-            w,
-            "| model | closed-loop mode [rad/s] | damping ratio | refined peak z / error [rad/s] | plain FFT peak of z over [0, 5] s [rad/s] |"
-        )?;
-        writeln!(w, "|---|---|---|---|---|")?;
-        for (o, end) in outcomes.iter().zip(ends) {
-            let m = &o.metrics;
-            writeln!(
-                w,
-                "| {} | {:.4} | {:.2e} | {:.4} / {:.4} | {:.4} (bin {}) |",
-                o.kind,
-                end.mode.omega,
-                end.mode.damping_ratio(),
-                m.z_peak_rad_s,
-                m.err_peak_rad_s,
-                m.z_fft_record_rad_s,
-                m.z_fft_record_bin
-            )?;
-        }
-
-        writeln!(w, "\n## Modes of every model\n")?;
-        let peaks: Vec<(&str, f64, f64)> = outcomes
-            .iter()
-            .map(|o| {
-                let m = &o.metrics;
-                (o.kind.name(), m.z_peak_rad_s, m.z_fft_record_rad_s)
-            })
-            .collect();
-        modes.write_section(w, &peaks)?;
-
-        writeln!(
-            w,
-            "\n## Static equilibria (MODELS.md §2 rule: effector x held, F0 unknown)\n"
-        )?;
-        writeln!(
-            w,
-            "| model | z at x1 [m] | F0 at x1 [N] | z at x2 [m] | F0 at x2 [N] |"
-        )?;
-        writeln!(w, "|---|---|---|---|---|")?;
-        for (o, end) in outcomes.iter().zip(ends) {
-            writeln!(
-                w,
-                "| {} | {} | {} | {} | {} |",
-                o.kind,
-                fixed(o.metrics.z0, 7),
-                fixed(o.metrics.f0, 6),
-                fixed(end.effector_height(), 7),
-                fixed(end.equilibrium.force(), 6)
-            )?;
-        }
-
-        writeln!(w, "\n## Solver statistics\n")?;
-        writeln!(
-            w,
-            "| model | RHS evaluations | accepted steps | rejected steps | pulley events | energy balance residual [J] |"
-        )?;
-        writeln!(w, "|---|---|---|---|---|---|")?;
-        for o in outcomes {
-            let m = &o.metrics;
-            writeln!(
-                w,
-                "| {} | {} | {} | {} | {} | {:.2e} |",
-                o.kind,
-                m.rhs_evals,
-                m.steps_accepted,
-                m.steps_rejected,
-                m.pulley_events,
-                m.energy_residual_max
-            )?;
-        }
-        writeln!(
-            w,
-            "\nWall times (this machine; the only numbers of this report that change between runs):\n"
-        )?;
-        writeln!(w, "| model | wall time [s] |")?;
-        writeln!(w, "|---|---|")?;
-        for o in outcomes {
-            writeln!(w, "| {} | {:.2} |", o.kind, o.run.wall_s)?;
-        }
-
-        writeln!(
-            w,
-            "\n## Vibration control: every controller on every cable model\n\n\
-             Beyond the paper: its PID and three controllers that act on z (`cargo xtask control`; \
-             control.csv has every number).\n"
-        )?;
-        w.write_all(control.as_bytes())?;
-
-        writeln!(w, "\n## Figures\n")?;
-        for (name, caption) in figures {
-            writeln!(
-                w,
-                "### {caption}\n\n![{caption}]({name}.svg)\n\nPNG: [{name}.png]({name}.png)\n"
-            )?;
-        }
-
-        writeln!(w, "## Software\n")?;
-        writeln!(
-            w,
-            "- cdpr-bench {} at git revision {}",
+    let software = [
+        format!(
+            "cdpr-bench {} at git revision {}",
             env!("CARGO_PKG_VERSION"),
             git_revision(out)
-        )?;
-        writeln!(w, "- {}", rustc_version())?;
-        writeln!(
-            w,
-            "- integrator: our DOPRI5 (Hairer's dopri5.f, β = {})",
-            sim.dopri_beta
-        )?;
-        Ok(())
-    })
-}
-
-/// `v` with `decimals` decimals, without the sign of a value that rounds to zero (the static
-/// F0 at the symmetric x = 0.5 is ±1e-12 N of round-off, which would print as "-0.000000").
-fn fixed(v: f64, decimals: usize) -> String {
-    let text = format!("{v:.decimals$}");
-    match text.strip_prefix('-') {
-        Some(magnitude) if magnitude.chars().all(|c| c == '0' || c == '.') => magnitude.to_string(),
-        _ => text,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::fixed;
-
-    #[test]
-    fn fixed_drops_the_sign_of_a_rounded_zero_only() {
-        assert_eq!(fixed(-1e-12, 6), "0.000000");
-        assert_eq!(fixed(-0.0, 3), "0.000");
-        assert_eq!(fixed(-0.0237291, 7), "-0.0237291");
-        assert_eq!(fixed(0.097531, 6), "0.097531");
-        assert_eq!(fixed(-4e-7, 6), "0.000000");
-        assert_eq!(fixed(-6e-7, 6), "-0.000001");
-    }
+        ),
+        rustc_version(),
+    ];
+    let inputs = ReportInputs {
+        base,
+        outcomes,
+        ends,
+        checks,
+        eq15,
+        figures,
+        modes,
+        control,
+        software: &software,
+    };
+    write_atomic(&out.join("REPORT.md"), |w| paper_report::write(w, &inputs))
 }

@@ -67,62 +67,21 @@ pub fn run(scenario: &Scenario, out: &Path, every: usize) -> Result<()> {
         cdpr_bench::simulate_spatial(scenario, &mut observer)
     };
     progress.finish();
-    let write_failure = stream.failure();
-    let (done, status, error): (Option<SpatialRun>, _, _) = match result {
-        Ok(done) => (Some(done), "complete", write_failure),
-        Err(Error::Run(failure)) => {
-            let status = match (&write_failure, &failure.error) {
-                (None, RunError::Interrupted { .. }) => "interrupted",
-                _ => "failed",
-            };
-            let error = write_failure.unwrap_or_else(|| failure.error.to_string());
-            let done = failure.partial.map(|run| {
-                let metrics = cdpr_bench::spatial_metrics_of(scenario, &run).ok();
-                (run, metrics)
-            });
-            match done {
-                Some((run, Some(metrics))) => {
-                    (Some(SpatialRun { run, metrics }), status, Some(error))
-                }
-                _ => (None, status, Some(error)),
-            }
-        }
-        Err(e) => (None, "failed", Some(e.to_string())),
-    };
+    let Ending {
+        done,
+        status,
+        error,
+    } = ending(scenario, result, stream.failure());
     let empty = cdpr_bench::core::series::TimeSeries::new(Vec::new());
     let written = stream.finish(
         done.as_ref().map_or(&empty, |d| &d.run.series),
         &out.join(TIMESERIES),
     );
-    let units = SpatialMetrics::UNITS
-        .into_iter()
-        .chain([("t_reached", "s"), ("move_end_s", "s")]);
-    write_json(
-        &out.join(METRICS),
-        &SpatialMetricsFile {
-            status,
-            error: error.clone(),
-            t_reached: done.as_ref().map_or(0.0, |d| d.run.t_reached),
-            provenance: &provenance,
-            metrics: done.as_ref().map(|d| &d.metrics),
-            steps: done.as_ref().map_or(0, |d| d.run.stats.steps_accepted),
-            rhs_evaluations: done.as_ref().map_or(0, |d| d.run.stats.rhs_evals),
-            units: units.collect(),
-        },
-    )?;
+    write_metrics(out, &provenance, done.as_ref(), status, error.clone())?;
     written?;
     if let Some(d) = &done {
         crate::spatial_figures::write(scenario, &d.run, out)?;
-        println!(
-            "elastic in space, {} cables: {} samples, {} RHS evaluations, {} accepted steps; path error during the move {:.3e} m, 1 s after {:.3e} m → {}",
-            d.metrics.cables,
-            d.run.series.len(),
-            d.run.stats.rhs_evals,
-            d.run.stats.steps_accepted,
-            d.metrics.path_err_max_move,
-            d.metrics.path_err_max_after_1s,
-            out.display()
-        );
+        summary(d, out);
     }
     match error {
         None => Ok(()),
@@ -133,4 +92,92 @@ pub fn run(scenario: &Scenario, out: &Path, every: usize) -> Result<()> {
             out.join(METRICS).display()
         ),
     }
+}
+
+/// How a spatial run ended: what it computed (complete, or the part a failed run sampled),
+/// "complete" | "failed" | "interrupted", and why it did not complete.
+struct Ending {
+    done: Option<SpatialRun>,
+    status: &'static str,
+    error: Option<String>,
+}
+
+/// The ending of `result`; a failed write of the samples fails the run whatever it did.
+fn ending(
+    scenario: &Scenario,
+    result: Result<SpatialRun, Error>,
+    write_failure: Option<String>,
+) -> Ending {
+    let failed = |done, error| Ending {
+        done,
+        status: "failed",
+        error: Some(error),
+    };
+    match result {
+        Ok(done) => match write_failure {
+            None => Ending {
+                done: Some(done),
+                status: "complete",
+                error: None,
+            },
+            Some(e) => failed(Some(done), e),
+        },
+        Err(Error::Run(failure)) => {
+            let status = match (&write_failure, &failure.error) {
+                (None, RunError::Interrupted { .. }) => "interrupted",
+                _ => "failed",
+            };
+            let error = write_failure.unwrap_or_else(|| failure.error.to_string());
+            let done = failure.partial.and_then(|run| {
+                let metrics = cdpr_bench::spatial_metrics_of(scenario, &run).ok()?;
+                Some(SpatialRun { run, metrics })
+            });
+            Ending {
+                done,
+                status,
+                error: Some(error),
+            }
+        }
+        Err(e) => failed(None, e.to_string()),
+    }
+}
+
+/// `metrics.json` for the run's ending.
+fn write_metrics(
+    out: &Path,
+    provenance: &Provenance,
+    done: Option<&SpatialRun>,
+    status: &'static str,
+    error: Option<String>,
+) -> Result<()> {
+    let units = SpatialMetrics::UNITS
+        .into_iter()
+        .chain([("t_reached", "s"), ("move_end_s", "s")]);
+    write_json(
+        &out.join(METRICS),
+        &SpatialMetricsFile {
+            status,
+            error,
+            t_reached: done.map_or(0.0, |d| d.run.t_reached),
+            provenance,
+            metrics: done.map(|d| &d.metrics),
+            steps: done.map_or(0, |d| d.run.stats.steps_accepted),
+            rhs_evaluations: done.map_or(0, |d| d.run.stats.rhs_evals),
+            units: units.collect(),
+        },
+    )
+}
+
+/// The run's summary on stdout.
+fn summary(d: &SpatialRun, out: &Path) {
+    println!(
+        "elastic in space, {} cables: {} samples, {} RHS evaluations, {} accepted steps; path error during the move {:.3e} m, 1 s after {:.3e} m → {}",
+        d.metrics.cables,
+        d.run.series.len(),
+        d.run.stats.rhs_evals,
+        d.run.stats.steps_accepted,
+        d.metrics.path_err_max_move,
+        d.metrics.path_err_max_after_1s,
+        out.display()
+    );
 }

@@ -29,11 +29,19 @@ const CABLE_COLORS: [RGBColor; 8] = [
 
 /// `path.svg|png` and `tensions.svg|png` of `run` into `out`.
 pub fn write(scenario: &Scenario, run: &Run, out: &Path) -> Result<()> {
+    if let Some(path) = path_figure(scenario, run) {
+        render(&path, out)?;
+    }
+    render(&tensions_figure(scenario, run), out)
+}
+
+/// The path in the top, front and side views, millimetres from the start.
+fn path_figure(scenario: &Scenario, run: &Run) -> Option<Figure> {
     let s = &run.series;
     let column = |c: Channel| s.channel(c).unwrap_or(&[]);
     let (x, y, z) = (column(Channel::X), column(Channel::Y), column(Channel::Z));
     if x.is_empty() {
-        return Ok(());
+        return None;
     }
     let origin = [x[0], y[0], z[0]];
     let every = x.len().div_ceil(PATH_POINTS).max(1);
@@ -84,14 +92,15 @@ pub fn write(scenario: &Scenario, run: &Run, out: &Path) -> Result<()> {
         }
     })
     .collect();
-    render(
-        &Figure {
-            name: "path".into(),
-            title: "Effector path in three projections".into(),
-            panels,
-        },
-        out,
-    )?;
+    Some(Figure {
+        name: "path".into(),
+        title: "Effector path in three projections".into(),
+        panels,
+    })
+}
+
+/// Each cable's tension against the box.
+fn tensions_figure(scenario: &Scenario, run: &Run) -> Figure {
     let m = run.equilibrium.tensions.len();
     let t_end = run.t_reached;
     let lines = CableId::all(m)
@@ -108,19 +117,16 @@ pub fn write(scenario: &Scenario, run: &Run, out: &Path) -> Result<()> {
         .into_iter()
         .filter_map(|(name, v)| v.map(|v| Marker::Horizontal(v, name.into())))
         .collect();
-    render(
-        &Figure {
-            name: "tensions".into(),
-            title: "Cable tensions".into(),
-            panels: vec![Panel {
-                x_label: "t [s]".into(),
-                y_label: "tension [N]".into(),
-                log_x: false,
-                log_y: false,
-                lines,
-                markers,
-            }],
-        },
-        out,
-    )
+    Figure {
+        name: "tensions".into(),
+        title: "Cable tensions".into(),
+        panels: vec![Panel {
+            x_label: "t [s]".into(),
+            y_label: "tension [N]".into(),
+            log_x: false,
+            log_y: false,
+            lines,
+            markers,
+        }],
+    }
 }
