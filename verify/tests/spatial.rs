@@ -99,6 +99,45 @@ fn the_paper_robot_in_space_equals_the_planar_run() {
     }
 }
 
+/// Two anchors given as 2-vectors, (0, 0) and (1, 0), are the paper's planar robot: the same
+/// run to the bit; other planar spellings are refused by name.
+#[test]
+fn planar_anchors_as_2_vectors_are_the_paper_robot() {
+    let short = "[simulation]\nt_final = 1.0\n[analysis]\nmodes = \"off\"\n";
+    let paper = cdpr_bench::scenario_from_toml_str(short).unwrap();
+    let spelled = cdpr_bench::scenario_from_toml_str(&format!(
+        "[robot]\nanchors = [[0.0, 0.0], [1.0, 0.0]]\n{short}"
+    ))
+    .unwrap();
+    assert_eq!(spelled, paper);
+    let (a, b) = (
+        simulate(&paper, &mut |_| {}).unwrap(),
+        simulate(&spelled, &mut |_| {}).unwrap(),
+    );
+    for i in 0..a.series.len() {
+        assert!(
+            a.series
+                .row(i)
+                .iter()
+                .zip(b.series.row(i))
+                .all(|(u, v)| u.to_bits() == v.to_bits())
+        );
+    }
+    for bad in [
+        "[[0.1, 0.0], [1.0, 0.0]]",
+        "[[0.0, 0.0], [1.0, 0.2]]",
+        "[[0.0, 0.0], [1.0, 0.0], [0.5, 1.0]]",
+    ] {
+        let err = cdpr_bench::scenario_from_toml_str(&format!("[robot]\nanchors = {bad}\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("robot.anchors") && err.contains("[[0, 0], [d, 0]]"),
+            "{bad}: {err}"
+        );
+    }
+}
+
 /// The out-of-plane mode of the paper's robot in space is the pendulum ω_y² = Σ T_i/(M l_i):
 /// the y-row of the elastic model's Jacobian at rest (tensions held), by central differences of
 /// its right-hand side (exact to ~1e-9 relative for a 1e-6 m step on a smooth field).

@@ -143,7 +143,7 @@ fn bad_robots_get_named_errors() {
         (
             "flat.toml",
             format!("[robot]\nanchors = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]\n{box_keys}"),
-            "three finite coordinates",
+            "two 2-vectors",
         ),
         (
             "nobox.toml",

@@ -34,6 +34,47 @@ pub struct Robot {
     pub anchors: Option<Vec<Vec<f64>>>,
 }
 
+impl Robot {
+    /// Two anchors given as 2-vectors are the planar robot, spelled as MODELS.md §1 draws it:
+    /// A1 = (0, 0), A2 = (d, 0) become `anchor_distance = d` (the same run, bit for bit). Other
+    /// 2-vector anchors are refused by name: the planar model's pulleys sit at those points.
+    fn read_planar_anchors(&mut self) -> Result<(), ScenarioError> {
+        let Some(anchors) = &self.anchors else {
+            return Ok(());
+        };
+        if !anchors.iter().any(|a| a.len() == 2) {
+            return Ok(());
+        }
+        let given = format!("{anchors:?}");
+        let d = match anchors.as_slice() {
+            [a, b] if a.as_slice() == [0.0, 0.0] && b.len() == 2 && b[1] == 0.0 => b[0],
+            _ => {
+                return Err(out_of_range(
+                    "robot.anchors",
+                    given,
+                    "two 2-vectors [[0, 0], [d, 0]] (the planar robot, MODELS.md §1), or 3-vectors \
+                     [[x, y, z], …] for a spatial robot",
+                ));
+            }
+        };
+        let default = Self::default().anchor_distance;
+        if self.anchor_distance != default && self.anchor_distance != d {
+            return Err(out_of_range(
+                "robot.anchors",
+                given,
+                format!(
+                    "A2 = (anchor_distance, 0) = ({}, 0), or anchor_distance left out",
+                    self.anchor_distance
+                ),
+            ));
+        }
+        positive("robot.anchors", d)?;
+        self.anchor_distance = d;
+        self.anchors = None;
+        Ok(())
+    }
+}
+
 impl Default for Robot {
     fn default() -> Self {
         Self {
@@ -367,8 +408,9 @@ impl Scenario {
 
     /// Parses and validates a scenario from TOML text.
     pub fn from_toml_str(text: &str) -> Result<Self, ScenarioError> {
-        let scenario: Scenario = toml::from_str(text)
+        let mut scenario: Scenario = toml::from_str(text)
             .map_err(|e| ScenarioError::Syntax(e.to_string().trim_end().to_owned()))?;
+        scenario.robot.read_planar_anchors()?;
         scenario.validate()?;
         Ok(scenario)
     }
