@@ -173,7 +173,16 @@ fn check(weights: [f64; 4], x2: f64) -> Result<(), TestCaseError> {
         p,
         weights,
     );
-    let error = (&reported - &expected).norm() / expected.norm();
+    close_gains(&reported, &expected, weights)
+}
+
+/// The reported gain within 1e-9 of the expected one (relative, Frobenius).
+fn close_gains(
+    reported: &DMatrix<f64>,
+    expected: &DMatrix<f64>,
+    weights: [f64; 4],
+) -> Result<(), TestCaseError> {
+    let error = (reported - expected).norm() / expected.norm();
     prop_assert!(
         error < 1e-9,
         "weights {:?}: reported\n{}\nexpected\n{}\nrelative error {:e}",
@@ -322,16 +331,7 @@ fn check_spatial(weights: [f64; 4], end: [f64; 3]) -> Result<(), TestCaseError> 
     let p = nalgebra::Vector3::from(end);
     let hold = one_redundancy_qp(&HANGPRINTER, 1.0, 9.81, p, (10.0, 70.0));
     let expected = expected_spatial_gain(&HANGPRINTER, 1.0, p, &hold, weights);
-    let error = (&reported - &expected).norm() / expected.norm();
-    prop_assert!(
-        error < 1e-9,
-        "weights {:?}: reported\n{}\nexpected\n{}\nrelative error {:e}",
-        weights,
-        reported,
-        expected,
-        error
-    );
-    Ok(())
+    close_gains(&reported, &expected, weights)
 }
 
 proptest! {

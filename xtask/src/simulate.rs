@@ -222,6 +222,28 @@ impl CsvStream {
     }
 }
 
+/// `run` watched by a progress bar labelled `label`, each sample written to `stream`, stopped
+/// by SIGINT/SIGTERM or a failed write ([`STOP`]).
+pub(crate) fn streamed<T>(
+    stream: &mut CsvStream,
+    label: &str,
+    run: impl FnOnce(&mut Observer) -> T,
+) -> T {
+    let mut progress = Progress::new(label);
+    let result = {
+        let mut on_sample = |row: &[f64]| stream.push(row);
+        let mut report = |f: f64| progress.set(f);
+        let mut observer = Observer {
+            progress: &mut report,
+            on_sample: Some(&mut on_sample),
+            stop: Some(&STOP),
+        };
+        run(&mut observer)
+    };
+    progress.finish();
+    result
+}
+
 /// How a run ended.
 struct Ending {
     status: &'static str,
@@ -257,18 +279,9 @@ pub fn run(
     let kind = model_kind(&scenario)?;
 
     let mut stream = CsvStream::create(out.join(PARTIAL), &headings, every)?;
-    let mut progress = Progress::new(kind.name());
-    let result = {
-        let mut on_sample = |row: &[f64]| stream.push(row);
-        let mut report = |f: f64| progress.set(f);
-        let mut observer = Observer {
-            progress: &mut report,
-            on_sample: Some(&mut on_sample),
-            stop: Some(&STOP),
-        };
-        cdpr_bench::assess_observed(&scenario, &mut observer)
-    };
-    progress.finish();
+    let result = streamed(&mut stream, kind.name(), |observer| {
+        cdpr_bench::assess_observed(&scenario, observer)
+    });
     let write_failure = stream.failure();
     let (assessed, ending) = match result {
         Ok(assessed) => (

@@ -4,14 +4,15 @@
 //! `metrics.json` saying how the run ended — with the spatial metrics (3-D path error, tensions
 //! and reel speeds per cable) and two figures: the path in three projections, the tensions.
 
-use crate::output::{Progress, write_json};
+use crate::output::write_json;
 use crate::simulate::{
-    CsvStream, METRICS, PARTIAL, STOP, TIMESERIES, check_memory, prepare_out, writable_out,
+    CsvStream, METRICS, PARTIAL, STOP, TIMESERIES, check_memory, prepare_out, streamed,
+    writable_out,
 };
 use anyhow::{Context, Result, bail};
 use cdpr_bench::analysis::spatial::SpatialMetrics;
 use cdpr_bench::core::channel::heading;
-use cdpr_bench::core::runner::{Observer, RunError, channel_names, channel_units};
+use cdpr_bench::core::runner::{RunError, channel_names, channel_units};
 use cdpr_bench::core::scenario::Scenario;
 use cdpr_bench::{Error, Provenance, SpatialRun};
 use cdpr_sweep::DirLock;
@@ -55,18 +56,9 @@ pub fn run(scenario: &Scenario, out: &Path, every: usize) -> Result<()> {
     ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
         .context("installing the SIGINT/SIGTERM handler")?;
     let mut stream = CsvStream::create(out.join(PARTIAL), &headings, every)?;
-    let mut progress = Progress::new("elastic (space)");
-    let result = {
-        let mut on_sample = |row: &[f64]| stream.push(row);
-        let mut report = |f: f64| progress.set(f);
-        let mut observer = Observer {
-            progress: &mut report,
-            on_sample: Some(&mut on_sample),
-            stop: Some(&STOP),
-        };
-        cdpr_bench::simulate_spatial(scenario, &mut observer)
-    };
-    progress.finish();
+    let result = streamed(&mut stream, "elastic (space)", |observer| {
+        cdpr_bench::simulate_spatial(scenario, observer)
+    });
     let Ending {
         done,
         status,

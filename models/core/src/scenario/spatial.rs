@@ -196,7 +196,7 @@ impl Scenario {
     }
 
     /// 0 ≤ t1 < t2.
-    fn validate_times(&self) -> Result<(), ScenarioError> {
+    pub(super) fn validate_times(&self) -> Result<(), ScenarioError> {
         let t = &self.trajectory;
         finite("trajectory.t1", t.t1)?;
         if t.t1 < 0.0 {

@@ -69,18 +69,7 @@ impl Scenario {
                 ));
             }
         }
-        finite("trajectory.t1", t.t1)?;
-        if t.t1 < 0.0 {
-            return Err(out_of_range("trajectory.t1", t.t1, "≥ 0 s"));
-        }
-        finite("trajectory.t2", t.t2)?;
-        if t.t2 <= t.t1 {
-            return Err(out_of_range(
-                "trajectory.t2",
-                t.t2,
-                format!("> t1 = {} s", t.t1),
-            ));
-        }
+        self.validate_times()?;
 
         let kind = self.controller.kind;
         match (kind.acts_on_z(), t.z_ref) {
