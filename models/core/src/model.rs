@@ -331,6 +331,20 @@ pub trait CableModel<const D: usize> {
     /// Σ T_i v_reel,i, so that d/dt (kinetic + elastic + gravity) = Σ T_i v_reel,i − dissipation.
     fn reel_speeds(&self, state: &[f64]) -> PerCable;
 
+    /// [`CableModel::rhs`] and [`CableModel::reel_speeds`] of one state in one call, as the
+    /// closed loop needs them: a model whose two share work (the massless cables' structure
+    /// matrix) computes it once. The default calls both.
+    fn rhs_and_reel_speeds(
+        &mut self,
+        t: f64,
+        state: &[f64],
+        tensions: &[f64],
+        rate: &mut [f64],
+    ) -> PerCable {
+        self.rhs(t, state, tensions, rate);
+        self.reel_speeds(state)
+    }
+
     /// Energy terms of `state`.
     fn energy(&self, state: &[f64]) -> Energy;
 
@@ -431,6 +445,15 @@ impl<const D: usize, M: CableModel<D> + ?Sized> CableModel<D> for Box<M> {
     }
     fn reel_speeds(&self, state: &[f64]) -> PerCable {
         (**self).reel_speeds(state)
+    }
+    fn rhs_and_reel_speeds(
+        &mut self,
+        t: f64,
+        state: &[f64],
+        tensions: &[f64],
+        rate: &mut [f64],
+    ) -> PerCable {
+        (**self).rhs_and_reel_speeds(t, state, tensions, rate)
     }
     fn energy(&self, state: &[f64]) -> Energy {
         (**self).energy(state)

@@ -289,6 +289,25 @@ impl<const D: usize> CableModel<D> for Elastic<D> {
         }
     }
 
+    /// Eq. 2 and the reels' speeds with the structure matrix W formed once (the same
+    /// arithmetic as [`CableModel::rhs`] and [`CableModel::reel_speeds`], so the same bits).
+    fn rhs_and_reel_speeds(
+        &mut self,
+        _t: f64,
+        y: &[f64],
+        tensions: &[f64],
+        rate: &mut [f64],
+    ) -> PerCable {
+        let r = &self.robot;
+        let e = self.effector(y);
+        let w = r.structure_matrix(&e.position);
+        let force = w.force(tensions) - along_vertical::<D>(r.effector_mass * r.gravity);
+        let acc = force / r.effector_mass;
+        rate[..D].copy_from_slice(&y[D..]);
+        rate[D..].copy_from_slice(acc.as_slice());
+        PerCable::from_fn(r.cables(), |i| w.column(i).dot(&e.velocity))
+    }
+
     /// Reeling-in rate = −dl_i/dt = e_i·v: the reel takes in what the effector's approach frees.
     fn reel_speeds(&self, y: &[f64]) -> PerCable {
         let e = self.effector(y);

@@ -221,7 +221,8 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         let effector = self.model.effector(&y[..n]);
         let reference = self.reference(t);
         let cmd = self.command_with(t, &reference, &effector, &y[n..n + self.controller_len()]);
-        self.controller_and_audit_rates(y, (&reference, &effector), &cmd, out);
+        let reel = self.model.reel_speeds(&y[..n]);
+        self.controller_and_audit_rates(y, (&reference, &effector), (&cmd, &reel), out);
     }
 
     fn residual_round_off(&self, y: &[f64]) -> f64 {

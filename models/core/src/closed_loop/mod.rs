@@ -17,7 +17,7 @@ pub use rest::LoopError;
 use crate::controller::{self, AnyController, Controller, Reference, TensionLimits};
 use crate::model::CableModel;
 use crate::robot::distribution::BOX_TOLERANCE;
-use crate::robot::{Effector, Robot, Tensions, Vector};
+use crate::robot::{Effector, PerCable, Robot, Tensions, Vector};
 use crate::scenario::{ControllerKind, Scenario};
 use crate::shaper::Impulses;
 use crate::trajectory::{Segment, Step5};
@@ -234,12 +234,12 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
     }
 
     /// Rates of the states after the model's (controller, W', D') at state `y` under `cmd`,
-    /// with the reference and the effector of (t, y).
+    /// with the reference and the effector of (t, y) and the reels' speeds there.
     fn controller_and_audit_rates(
         &self,
         y: &[f64],
         (reference, effector): (&Reference<D>, &Effector<D>),
-        cmd: &Command,
+        (cmd, reel): (&Command, &PerCable),
         out: &mut [f64],
     ) {
         let n = self.model_len();
@@ -248,8 +248,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         let (rates, audits) = out.split_at_mut(c);
         self.controller
             .state_rate(reference, effector, &y[n..n + c], cmd.saturated, rates);
-        let reel = self.model.reel_speeds(model_state);
-        audits[0] = cmd.tensions.dot(&reel);
+        audits[0] = cmd.tensions.dot(reel);
         audits[1] = self.model.dissipation(model_state);
     }
 }
@@ -266,7 +265,9 @@ impl<M: CableModel<D>, const D: usize> OdeSystem for ClosedLoop<M, D> {
         let states = &y[n..n + self.controller_len()];
         let cmd = self.command_with(t, &reference, &effector, states);
         let (model_rate, tail) = dy.split_at_mut(n);
-        self.model.rhs(t, &y[..n], &cmd.tensions, model_rate);
-        self.controller_and_audit_rates(y, (&reference, &effector), &cmd, tail);
+        let reel = self
+            .model
+            .rhs_and_reel_speeds(t, &y[..n], &cmd.tensions, model_rate);
+        self.controller_and_audit_rates(y, (&reference, &effector), (&cmd, &reel), tail);
     }
 }
