@@ -404,6 +404,29 @@ fn hangprinter_move_goals() {
     );
 }
 
+/// Every example robot's own move (Hangprinter 4 cables; CoGiRo and IPAnema 8, IPAnema with
+/// t_min = 0 so that four cables rest idle at 0 N) under computed-torque with the exact QP: the
+/// path within 1 µm, every tension inside the file's box.
+#[test]
+fn every_example_robot_follows_its_move() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/robots");
+    for name in ["hangprinter", "cogiro", "ipanema"] {
+        let s = cdpr_bench::scenario_from_file(&dir.join(format!("{name}.toml"))).unwrap();
+        let m = run_spatial(&s).unwrap().metrics;
+        let (t_min, t_max) = (s.controller.t_min.unwrap(), s.controller.t_max.unwrap());
+        assert!(
+            m.path_err_max_move < 1e-6,
+            "{name}: {}",
+            m.path_err_max_move
+        );
+        assert!(
+            m.tension_min >= t_min - 1e-9 && m.tension_max <= t_max + 1e-9,
+            "{name}: {m:?}"
+        );
+        assert_eq!(m.saturated_s, 0.0, "{name}");
+    }
+}
+
 /// Bad input gets a named error before any work.
 #[test]
 fn bad_spatial_input_is_refused_by_name() {

@@ -124,7 +124,10 @@ fn spatial_runs_are_refused_before_any_file() {
         );
         assert!(!out.join("metrics.json").exists(), "{file}");
     }
-    let statics_only = xtask(&["simulate"], &example("cogiro.toml"), &dir.join("cogiro"));
+    let statics = dir.join("statics.toml");
+    let robot_only = base.split("[trajectory]").next().unwrap();
+    std::fs::write(&statics, robot_only).unwrap();
+    let statics_only = xtask(&["simulate"], &statics, &dir.join("statics"));
     let stderr = String::from_utf8_lossy(&statics_only.stderr);
     assert!(stderr.contains("trajectory.start"), "{stderr}");
 }

@@ -199,10 +199,12 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         self.command_with(t, &self.reference(t), &effector, states)
     }
 
-    /// Whether a cable may go slack (zero tension) without failing the run: reels driven by
-    /// length, whose cables pull only with their strain.
+    /// Whether a cable may carry zero tension without failing the run: reels driven by length,
+    /// whose cables pull only with their strain, and any spatial robot, whose distribution may
+    /// leave a cable idle at t_min = 0 (IPAnema's box is [0, 720] N). A negative tension still
+    /// fails.
     pub fn slack_allowed(&self) -> bool {
-        self.controller.kind() == ControllerKind::Length
+        D == 3 || self.controller.kind() == ControllerKind::Length
     }
 
     /// The command for a given reference, effector and controller states.
