@@ -50,10 +50,21 @@ pub struct SpatialRun {
     pub metrics: SpatialMetrics,
 }
 
-/// The spatial robot's move, shaper and tension box, checked: the model elastic (massive
-/// cables run on the plane's robot only, so far), the move given for three or more cables, the
-/// reference feasible.
+/// The spatial robot's move, shaper and tension box, checked: the robot and its model
+/// ([`spatial_robot`]), the move given for three or more cables, the reference feasible.
 pub fn prepare_spatial(scenario: &Scenario) -> Result<Robot<3>, Error> {
+    let robot = spatial_robot(scenario)?;
+    if robot.cables() >= 3 {
+        let path = segment(scenario)?;
+        let shaper = scenario.trajectory.impulses()?;
+        check_reference(scenario, &robot, &path, shaper.as_ref())?;
+    }
+    Ok(robot)
+}
+
+/// The scenario's spatial robot with its model checked (elastic: the massive cables run on the
+/// plane's robot only, so far) — what a statics or modes study needs, without the move.
+pub fn spatial_robot(scenario: &Scenario) -> Result<Robot<3>, Error> {
     let robot = scenario.spatial_robot().ok_or_else(|| {
         out_of_range(
             "robot.anchors",
@@ -72,11 +83,6 @@ pub fn prepare_spatial(scenario: &Scenario) -> Result<Robot<3>, Error> {
         .into());
     }
     cdpr_elastic::Params {}.validate(scenario)?;
-    if robot.cables() >= 3 {
-        let path = segment(scenario)?;
-        let shaper = scenario.trajectory.impulses()?;
-        check_reference(scenario, &robot, &path, shaper.as_ref())?;
-    }
     Ok(robot)
 }
 
@@ -179,16 +185,24 @@ pub fn simulate_spatial_into(
     Ok(SpatialRun { run, metrics })
 }
 
-/// The closed loop of a spatial scenario (checked by [`prepare_spatial`]).
+/// The closed loop of a spatial scenario, checked whole by [`prepare_spatial`].
 fn spatial_loop(scenario: &Scenario) -> Result<ClosedLoop<Elastic<3>, 3>, Error> {
-    let robot = prepare_spatial(scenario)?;
+    loop_of(scenario, prepare_spatial(scenario)?)
+}
+
+/// The closed loop of `robot` under `scenario`, the reference not checked again.
+fn loop_of(scenario: &Scenario, robot: Robot<3>) -> Result<ClosedLoop<Elastic<3>, 3>, Error> {
     let model = Elastic::new(robot, scenario.cable.axial_stiffness());
     Ok(ClosedLoop::new(model, scenario)?)
 }
 
 /// The metrics of `run` (e.g. the part a failed run sampled) of the spatial `scenario`.
 pub fn spatial_metrics_of(scenario: &Scenario, run: &Run) -> Result<SpatialMetrics, Error> {
-    Ok(spatial_metrics(scenario, &spatial_loop(scenario)?, run))
+    Ok(spatial_metrics(
+        scenario,
+        &loop_of(scenario, spatial_robot(scenario)?)?,
+        run,
+    ))
 }
 
 /// The spatial scenario ready to run: checked as [`prepare_spatial`] does, and its loop
@@ -201,8 +215,8 @@ pub fn prepare_spatial_start(scenario: &Scenario) -> Result<(), Error> {
 
 /// The number of channels of a spatial scenario's run.
 pub fn spatial_channels(scenario: &Scenario) -> Result<usize, Error> {
-    let sys = spatial_loop(scenario)?;
-    Ok(cdpr_core::runner::channel_names(&sys.model).len())
+    let model = Elastic::new(spatial_robot(scenario)?, scenario.cable.axial_stiffness());
+    Ok(cdpr_core::runner::channel_names(&model).len())
 }
 
 /// The metrics of a spatial run of `scenario` on the loop `sys`.

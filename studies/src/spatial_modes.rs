@@ -53,7 +53,7 @@ pub struct SpatialModes {
 /// The modes of `scenario`'s robot at rest at `pose` [m] (two cables: at rest at x = pose[0],
 /// the other coordinates found by the statics).
 pub fn at_pose(scenario: &Scenario, pose: [f64; 3]) -> Result<SpatialModes> {
-    let robot = cdpr_bench::prepare_spatial(scenario)?;
+    let robot = cdpr_bench::spatial_robot(scenario)?;
     // The loop held at rest at the pose: a move of zero length (two cables: the paper's rule
     // at x, the height and y its statics').
     let mut closed_scenario = scenario.clone();

@@ -41,7 +41,7 @@ pub fn run(scenario: &Scenario, out: &Path, every: usize) -> Result<()> {
     // What can be known before the run (the reference's feasibility, the start, the
     // controller's design): refused here, before anything is written.
     cdpr_bench::prepare(scenario)?;
-    let robot = cdpr_bench::prepare_spatial(scenario)?;
+    let robot = cdpr_bench::spatial_robot(scenario)?;
     let provenance = Provenance::of(scenario)?;
     writable_out(out)?;
     let _lock = DirLock::acquire(out, "simulate")?;

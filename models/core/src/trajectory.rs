@@ -112,6 +112,11 @@ impl Step5 {
 /// // The arc length's largest speed, 15 L / (8 T), at the middle of the move.
 /// let length = (move_.end - move_.start).norm();
 /// assert!((move_.velocity(0.1).norm() - 15.0 * length / (8.0 * 0.2)).abs() < 1e-12);
+/// assert!((move_.max_speed() - move_.velocity(0.1).norm()).abs() < 1e-12);
+/// // The issue's Hangprinter move: 10 L/(√3 T²) = 16.39 m/s² at Δ = 1/2 − √3/6.
+/// let t_peak = (0.5 - 3f64.sqrt() / 6.0) * 0.2;
+/// assert!((move_.acceleration(t_peak).norm() - move_.max_acceleration()).abs() < 1e-9);
+/// assert!((move_.max_acceleration() - 16.394).abs() < 1e-3);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Segment<const D: usize> {
@@ -158,11 +163,6 @@ impl<const D: usize> Segment<D> {
     /// p̈(t) [m/s²].
     pub fn acceleration(&self, t: f64) -> Vector<D> {
         (self.end - self.start) * self.unit().acceleration(t)
-    }
-
-    /// The unit quintic σ(t), σ̇, σ̈ (for the shaper's convolution).
-    pub fn progress(&self) -> Step5 {
-        self.unit()
     }
 
     /// p_ref, ṗ_ref, p̈_ref at t [s]: σ convolved with `shaper`'s impulses (None or one unit

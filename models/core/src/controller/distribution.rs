@@ -123,7 +123,10 @@ impl TensionSolver {
         p: &Vector<D>,
         force: &Vector<D>,
     ) -> Tensions {
-        if let Some(t) = robot.tensions_for_force(p, force) {
+        // As many cables as axes: W T = f directly (W formed there, once).
+        if robot.cables() == D
+            && let Some(t) = robot.tensions_for_force(p, force)
+        {
             return t;
         }
         distribute(self.method, &robot.structure_matrix(p), force, self.limits).map_or_else(

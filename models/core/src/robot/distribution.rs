@@ -152,6 +152,14 @@ fn inside(t: &Tensions, limits: TensionBox) -> bool {
     t.iter().all(|&v| limits.violation(v) <= BOX_TOLERANCE)
 }
 
+/// (W Wᵀ)⁻¹ over every cable; W of full row rank or the error.
+fn full_gram_inverse<const D: usize>(
+    w: &StructureMatrix<D>,
+) -> Result<Matrix<D>, DistributionError> {
+    let all = [true; MAX_CABLES];
+    gram_inverse(w, &all[..w.columns().len()]).ok_or(DistributionError::RankDeficient { axes: D })
+}
+
 /// Σ_{i free} u_i u_iᵀ, inverted; None when the free cables span fewer than D directions.
 fn gram_inverse<const D: usize>(w: &StructureMatrix<D>, free: &[bool]) -> Option<Matrix<D>> {
     let mut g = Matrix::<D>::zeros();
@@ -271,11 +279,10 @@ fn puncture<const D: usize>(
     limits: TensionBox,
 ) -> Result<Distribution, DistributionError> {
     let m = w.columns().len();
-    let all = [true; MAX_CABLES];
-    let g_inv = gram_inverse(w, &all[..m]).ok_or(DistributionError::RankDeficient { axes: D })?;
+    let g_inv = full_gram_inverse(w)?;
     let lambda = g_inv * wrench;
     let minimum_norm = Tensions::from_fn(m, |i| w.column(i).dot(&lambda));
-    let closed = closed_form(w, &all[..m], wrench, limits.middle())
+    let closed = closed_form(w, &[true; MAX_CABLES][..m], wrench, limits.middle())
         .ok_or(DistributionError::RankDeficient { axes: D })?;
     // T(s) = a + s b, b = T(1) − T(0): each bound is an interval of s.
     let (mut lo, mut hi) = (0.0f64, 1.0f64);
@@ -317,8 +324,7 @@ fn qp<const D: usize>(
     limits: TensionBox,
 ) -> Result<Distribution, DistributionError> {
     let m = w.columns().len();
-    let all = [true; MAX_CABLES];
-    let g_inv = gram_inverse(w, &all[..m]).ok_or(DistributionError::RankDeficient { axes: D })?;
+    let g_inv = full_gram_inverse(w)?;
     if m == D + 1 {
         return Ok(qp_on_the_line(w, wrench, &g_inv, limits));
     }
