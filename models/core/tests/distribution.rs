@@ -235,3 +235,28 @@ fn an_impossible_wrench_is_infeasible_everywhere() {
     assert!(!d.clamped.is_empty());
     assert!(margin(&w, &wrench, limits).unwrap() < 0.0);
 }
+
+/// The case the proptest above once found: five cables, one on t_min, an ill-conditioned free
+/// set whose Gram inverse left W T = w at 1.5e-10 N against a 1e-10 N tolerance; one step of
+/// iterative refinement in the active-set enumeration takes it to 3e-12 N.
+#[test]
+fn an_ill_conditioned_free_set_still_balances() {
+    let mass = 7.329690783446254;
+    let robot = robot(5, 1.5, 2.0, mass);
+    let p = Vector::<3>::new(-0.160457155443845, 0.09133843384223121, 0.6779932371600963);
+    let w = robot.structure_matrix(&p);
+    let wrench = Vector::<3>::new(0.7223305425063014, 0.0, -0.6600799543265027 + 9.81) * mass;
+    let t_max = 947.966698394644;
+    let limits = TensionBox {
+        t_min: 0.05 * t_max,
+        t_max,
+    };
+    let d = distribute(DistributionMethod::Qp, &w, &wrench, limits).unwrap();
+    let t_norm = d.tensions.iter().map(|t| t * t).sum::<f64>().sqrt();
+    let error = (w.force(&d.tensions) - wrench).norm();
+    assert!(d.feasible);
+    assert!(
+        error <= balance_tolerance(wrench.norm(), t_norm),
+        "‖WT − w‖ = {error:e}"
+    );
+}

@@ -504,7 +504,14 @@ fn qp_by_enumeration<const D: usize>(
         let Some(g_inv) = gram_inverse(w, &free[..m]) else {
             continue;
         };
-        let lambda = g_inv * rhs;
+        // One step of iterative refinement: an ill-conditioned free set's inverse leaves
+        // W_F W_Fᵀ λ = rhs to ~cond·ε, the residual's correction takes it to round-off.
+        let mut lambda = g_inv * rhs;
+        let mut residual = rhs;
+        for i in (0..m).filter(|&i| free[i]) {
+            residual -= w.column(i) * w.column(i).dot(&lambda);
+        }
+        lambda += g_inv * residual;
         let consistent = (0..m).all(|i| {
             let z = w.column(i).dot(&lambda);
             match state[i] {
