@@ -25,10 +25,12 @@ fn paper(kind: ModelKind, integrator: IntegratorKind) -> Scenario {
 /// differences over every column, at a static equilibrium perturbed by velocities and
 /// accelerations. The reference steps are 1e-7·max(|u|, 1e-2): 140 times below the springs'
 /// stretch (1.4e-5 m for lumped N = 40, 2.8e-5 m for FE N = 10), so no probe reaches the
-/// tension-only kink, and small against the lumped first free node's distance to the pulley,
-/// where the path turns on that scale (the earlier ε^(1/3)·|u| ≈ 6e-6 m erred there by 3e-6 of
-/// the matrix, found when the models' own steps were limited to the smooth region); their
-/// round-off, k·ulp(1 m)/δ ≈ 1.6e-2 N/m times c_q ≤ 1e-7 s², is far below. The models' own
+/// tension-only kink; and at most 1e-3 of the lumped first free node's distance to its pulley,
+/// where the straddling spring's transverse stiffness T/|P − a| turns on that scale (central
+/// differences err by ~(δ/|P − a|)²: at x = 0.52537 that node sits 1.17 µm from the pulley and
+/// a 1e-7 m step erred by 2e-4 of the entry, 4e-5 of the matrix). Each step is the exact
+/// difference of the perturbed and unperturbed coordinate; the round-off,
+/// k·ulp(1 m)/δ ≤ 2e-2 N/m for δ ≥ 1e-9 m, times c_q ≤ 1e-6 s², stays far below. The models' own
 /// matrices (lumped: analytic when undamped, coloured central differences when damped; FE:
 /// element-local central differences) are exact or err by ~1e-10 relative, so
 /// 1e-6 of the matrix's largest entry separates round-off from a wrong derivative (a missed
@@ -72,6 +74,10 @@ fn check_iteration_matrix(
         model_s[r * n + c] += v;
         declared[r * n + c] = true;
     }
+    let turn = match kind {
+        ModelKind::Lumped => 1e-3 * nearest_to_pulley(&state, n, scenario.robot.anchor_distance),
+        _ => f64::INFINITY,
+    };
     let mut fd_s = vec![0.0; n * n];
     let (mut plus, mut minus) = (vec![0.0; n], vec![0.0; n]);
     for col in 0..n {
@@ -82,8 +88,8 @@ fn check_iteration_matrix(
                 1 => &mut s[n + col],
                 _ => &mut a[col],
             };
-            let step = 1e-7 * slot.abs().max(1e-2);
             let x0 = *slot;
+            let step = (x0 + (1e-7 * x0.abs().max(1e-2)).min(turn)) - x0;
             *slot = x0 + step;
             form.residual(&s, &a, &tensions, &mut plus);
             let slot = match which {
@@ -114,6 +120,37 @@ fn check_iteration_matrix(
             }
         }
     }
+}
+
+/// The case the proptest found: cable 1's first free node 1.17 µm from its pulley. A 1e-7 m
+/// reference step erred there by 2e-4 of S[101][101] (4e-5 of the matrix, against the 1e-6
+/// tolerance); the step limited by that distance meets it.
+#[test]
+fn lumped_matrix_matches_differences_with_a_node_at_its_pulley() {
+    let (c_v, c_q) = AlphaCoefficients::new(0.0).derivatives(6.266673666152767e-4);
+    check_iteration_matrix(
+        ModelKind::Lumped,
+        FeStored::Elastic,
+        0.0,
+        0.5253740500850752,
+        0.0,
+        c_v,
+        c_q,
+    );
+}
+
+/// Smallest distance of a lumped node to its cable's pulley [m] (layout of `Lumped`: the first
+/// 4N coordinates are cable 0's x, its z, cable 1's x, its z; pulleys at (0, 0) and (d, 0)).
+fn nearest_to_pulley(state: &[f64], dofs: usize, anchor_distance: f64) -> f64 {
+    let n = (dofs - 2) / 4;
+    (0..2)
+        .flat_map(|cable| (0..n).map(move |j| (cable, j)))
+        .map(|(cable, j)| {
+            let pulley_x = if cable == 0 { 0.0 } else { anchor_distance };
+            let (x, z) = (state[2 * cable * n + j], state[(2 * cable + 1) * n + j]);
+            (x - pulley_x).hypot(z)
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 proptest! {
