@@ -9,6 +9,7 @@
 //! the core (the robot and its runner) stays free of FFTs and eigen-solvers, and an analysis can
 //! be added without touching what is simulated.
 
+pub mod contour;
 pub mod control_metrics;
 pub mod damping;
 pub mod linearise;

@@ -5,3 +5,4 @@
 
 pub mod gcode;
 pub mod planner;
+pub mod shaper;

@@ -82,6 +82,8 @@ fn error(e: Error) -> PyErr {
         Error::Run(failure) => SimulationError::new_err(failure.to_string()),
         Error::Analysis(e) => SimulationError::new_err(e.to_string()),
         Error::Reference(e) => ScenarioError::new_err(e.to_string()),
+        Error::Gcode(e) => ScenarioError::new_err(e.to_string()),
+        Error::Plan(e) => ScenarioError::new_err(e.to_string()),
     }
 }
 

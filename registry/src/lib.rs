@@ -42,6 +42,7 @@ mod build;
 mod config;
 mod kind;
 pub mod memory;
+mod print;
 mod provenance;
 mod spatial;
 mod study;
@@ -51,11 +52,15 @@ pub use config::{
     ModelConfig, scenario_from_file, scenario_from_toml_str, validate, with_model_kind,
 };
 pub use kind::ModelKind;
+pub use print::{
+    FEASIBILITY_RATE, PreparedPrint, PrintRun, SETTLE, contour_of, prepare_print, print_options,
+    simulate_print,
+};
 pub use provenance::{Provenance, project_revision, revision};
 pub use spatial::{
-    FEASIBILITY_SAMPLES, InfeasibleReference, SpatialRun, check_reference, prepare_spatial,
-    prepare_spatial_start, simulate_spatial, simulate_spatial_into, spatial_channels,
-    spatial_metrics, spatial_metrics_of, spatial_robot,
+    FEASIBILITY_SAMPLES, InfeasibleReference, SpatialRun, check_feasible, check_reference,
+    prepare_spatial, prepare_spatial_start, simulate_spatial, simulate_spatial_into,
+    spatial_channels, spatial_metrics, spatial_metrics_of, spatial_robot,
 };
 pub use study::{
     Assessed, EndAnalysis, Error, analyse, assess, assess_observed, assess_observed_into,
@@ -71,3 +76,4 @@ pub use cdpr_elastic as elastic;
 pub use cdpr_fe as fe;
 pub use cdpr_lumped as lumped;
 pub use cdpr_numerics as numerics;
+pub use cdpr_printing as printing;

@@ -106,20 +106,36 @@ pub fn check_reference(
     path: &Segment<3>,
     shaper: Option<&Impulses>,
 ) -> Result<(), Error> {
+    let end = path.t2 + shaper.map_or(0.0, Impulses::duration);
+    let n = FEASIBILITY_SAMPLES;
+    let times = (0..=n + 1).map(|k| {
+        if k == 0 {
+            0.0
+        } else {
+            path.t1 + (end - path.t1) * (k - 1) as f64 / n as f64
+        }
+    });
+    check_feasible(scenario, robot, times, |t| {
+        let [p, _, a] = path.shaped(shaper, t, true);
+        (p, a)
+    })
+}
+
+/// The wrench-feasibility check at the given `times` [s] of a reference giving (p_ref, p̈_ref)
+/// (see [`check_reference`]).
+pub fn check_feasible(
+    scenario: &Scenario,
+    robot: &Robot<3>,
+    times: impl Iterator<Item = f64>,
+    reference: impl Fn(f64) -> (Vector<3>, Vector<3>),
+) -> Result<(), Error> {
     let limits = TensionBox {
         t_min: scenario.controller.t_min.unwrap_or(0.0),
         t_max: scenario.controller.t_max.unwrap_or(f64::INFINITY),
     };
-    let end = path.t2 + shaper.map_or(0.0, Impulses::duration);
     let mass = robot.effector_mass;
-    let n = FEASIBILITY_SAMPLES;
-    for k in 0..=n + 1 {
-        let t = if k == 0 {
-            0.0
-        } else {
-            path.t1 + (end - path.t1) * (k - 1) as f64 / n as f64
-        };
-        let [p, _, a] = path.shaped(shaper, t, true);
+    for t in times {
+        let (p, a) = reference(t);
         let lift = along_vertical::<3>(robot.gravity);
         for (load, wrench) in [
             ("at rest", lift * mass),
@@ -191,7 +207,10 @@ fn spatial_loop(scenario: &Scenario) -> Result<ClosedLoop<Elastic<3>, 3>, Error>
 }
 
 /// The closed loop of `robot` under `scenario`, the reference not checked again.
-fn loop_of(scenario: &Scenario, robot: Robot<3>) -> Result<ClosedLoop<Elastic<3>, 3>, Error> {
+pub(crate) fn loop_of(
+    scenario: &Scenario,
+    robot: Robot<3>,
+) -> Result<ClosedLoop<Elastic<3>, 3>, Error> {
     let model = Elastic::new(robot, scenario.cable.axial_stiffness());
     Ok(ClosedLoop::new(model, scenario)?)
 }
@@ -226,7 +245,7 @@ pub fn spatial_metrics<M: cdpr_core::model::CableModel<3>>(
     run: &Run,
 ) -> SpatialMetrics {
     let context = SpatialContext {
-        path: sys.path,
+        path: sys.path.as_ref().and_then(|p| p.as_move().copied()),
         shaper: sys.shaper.clone(),
         move_start: scenario.trajectory.t1,
         move_end: sys.move_end(),

@@ -41,6 +41,12 @@ pub enum Error {
     /// A spatial reference that no tensions in the box can follow.
     #[error(transparent)]
     Reference(#[from] crate::spatial::InfeasibleReference),
+    /// A G-code file the reader refuses.
+    #[error(transparent)]
+    Gcode(#[from] cdpr_printing::gcode::GcodeError),
+    /// A program the planner refuses.
+    #[error(transparent)]
+    Plan(#[from] cdpr_printing::planner::PlanError),
 }
 
 impl From<BuildError> for Error {

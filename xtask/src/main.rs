@@ -16,6 +16,8 @@ mod figures;
 mod heatmap;
 mod modes;
 mod output;
+mod print;
+mod print_figures;
 mod report;
 mod shaping;
 mod simulate;
@@ -145,6 +147,38 @@ enum Command {
         #[arg(long, default_value_t = 250)]
         tension_steps: usize,
     },
+    /// The firmware's motion plan of a G-code file (Klipper's planner, `[printer]` limits)
+    /// → DIR/plan.csv, one row per moving segment in the robot's frame.
+    Plan {
+        /// Scenario file with `[printer]` (absent: Klipper's defaults, origin at 0).
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// G-code file (a slicer's output, millimetres).
+        #[arg(long)]
+        gcode: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// A G-code file printed by a simulated spatial robot → DIR/metrics.json (contour error
+    /// overall and per move type), DIR/print.csv and a figure per layer.
+    Print {
+        /// Scenario file with `[robot] anchors` and `[printer]` (e.g. examples/printing/hangprinter.toml).
+        #[arg(long)]
+        scenario: PathBuf,
+        /// G-code file (a slicer's output, millimetres).
+        #[arg(long)]
+        gcode: PathBuf,
+        /// Layers to print, `A..B` or `A` (0 = before the first `;LAYER_CHANGE`); absent: all.
+        #[arg(long, value_parser = print::parse_layers)]
+        layers: Option<std::ops::RangeInclusive<usize>>,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Write every K-th sample to print.csv (metrics always use every sample); K ≥ 1.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+        every: u64,
+    },
     /// A spatial robot's move (`[trajectory] start`, `end`) under every controller and every
     /// tension distribution → DIR/moves.json and DIR/moves.md (docs/spatial.md's table).
     SpatialMoves {
@@ -218,6 +252,24 @@ fn main() -> ExitCode {
         Command::Shaping { scenario, out } => shaping::run_study(scenario.as_deref(), &out),
         Command::Distribution { scenario, at, out } => distribution::run(&scenario, &at, &out),
         Command::SpatialMoves { scenario, out } => spatial_moves::run(&scenario, &out),
+        Command::Plan {
+            scenario,
+            gcode,
+            out,
+        } => print::plan(scenario.as_deref(), &gcode, &out),
+        Command::Print {
+            scenario,
+            gcode,
+            layers,
+            out,
+            every,
+        } => print::print(&print::PrintOptions {
+            scenario: &scenario,
+            gcode: &gcode,
+            layers,
+            out: &out,
+            every: every as usize,
+        }),
         Command::Sweep {
             grid,
             out,

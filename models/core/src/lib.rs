@@ -15,6 +15,7 @@ pub mod fixed_end;
 pub mod geometry;
 pub mod modal_layout;
 pub mod model;
+pub mod print_path;
 pub mod robot;
 pub mod runner;
 pub mod scenario;

@@ -66,69 +66,69 @@ impl Limits {
     /// Refuses a value outside Klipper's range, naming the `[printer]` key.
     pub fn validate(&self) -> Result<(), PlanError> {
         let e = &self.extruder;
-        let checks: [(&str, f64, bool, &str); 11] = [
+        let checks: [(&'static str, f64, bool, &str); 11] = [
             (
-                "max_velocity",
+                "printer.max_velocity",
                 self.max_velocity,
                 self.max_velocity > 0.0,
                 "> 0 m/s",
             ),
             (
-                "max_accel",
+                "printer.max_accel",
                 self.max_accel,
                 self.max_accel > 0.0,
                 "> 0 m/s²",
             ),
             (
-                "square_corner_velocity",
+                "printer.square_corner_velocity",
                 self.square_corner_velocity,
                 self.square_corner_velocity >= 0.0,
                 "≥ 0 m/s",
             ),
             (
-                "minimum_cruise_ratio",
+                "printer.minimum_cruise_ratio",
                 self.minimum_cruise_ratio,
                 (0.0..1.0).contains(&self.minimum_cruise_ratio),
                 "0 ≤ ratio < 1",
             ),
             (
-                "nozzle_diameter",
+                "printer.nozzle_diameter",
                 e.nozzle_diameter,
                 e.nozzle_diameter > 0.0,
                 "> 0 m",
             ),
             (
-                "filament_diameter",
+                "printer.filament_diameter",
                 e.filament_diameter,
                 e.filament_diameter >= e.nozzle_diameter,
                 "≥ nozzle_diameter",
             ),
             (
-                "max_extrude_cross_section",
+                "printer.max_extrude_cross_section",
                 e.max_extrude_cross_section.unwrap_or(1.0),
                 e.max_extrude_cross_section.is_none_or(|v| v > 0.0),
                 "> 0 m²",
             ),
             (
-                "max_extrude_only_velocity",
+                "printer.max_extrude_only_velocity",
                 e.max_extrude_only_velocity.unwrap_or(1.0),
                 e.max_extrude_only_velocity.is_none_or(|v| v > 0.0),
                 "> 0 m/s",
             ),
             (
-                "max_extrude_only_accel",
+                "printer.max_extrude_only_accel",
                 e.max_extrude_only_accel.unwrap_or(1.0),
                 e.max_extrude_only_accel.is_none_or(|v| v > 0.0),
                 "> 0 m/s²",
             ),
             (
-                "max_extrude_only_distance",
+                "printer.max_extrude_only_distance",
                 e.max_extrude_only_distance,
                 e.max_extrude_only_distance >= 0.0,
                 "≥ 0 m",
             ),
             (
-                "instantaneous_corner_velocity",
+                "printer.instantaneous_corner_velocity",
                 e.instantaneous_corner_velocity,
                 e.instantaneous_corner_velocity >= 0.0,
                 "≥ 0 m/s",
@@ -137,7 +137,7 @@ impl Limits {
         for (key, value, ok, allowed) in checks {
             if !ok || !value.is_finite() {
                 return Err(PlanError::Limit {
-                    key: format!("printer.{key}"),
+                    key,
                     value,
                     allowed: allowed.to_string(),
                 });
@@ -181,7 +181,7 @@ pub enum PlanError {
     #[error("{key} = {value} is out of range: allowed {allowed}")]
     Limit {
         /// The key, e.g. `printer.max_accel`.
-        key: String,
+        key: &'static str,
         /// Its value (SI).
         value: f64,
         /// The allowed range.

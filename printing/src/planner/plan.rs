@@ -137,6 +137,33 @@ impl Plan {
         ))
     }
 
+    /// The part that prints `layers`: from the last rest before its first move to the first
+    /// rest after its last, re-timed from 0 (None when those layers do not move).
+    pub fn select_layers(&self, layers: std::ops::RangeInclusive<usize>) -> Option<Plan> {
+        let s = &self.segments;
+        let mut first = s.iter().position(|g| layers.contains(&g.layer))?;
+        let mut last = s.iter().rposition(|g| layers.contains(&g.layer))?;
+        while first > 0 && s[first].start_v > 0.0 {
+            first -= 1;
+        }
+        while last + 1 < s.len() && s[last].end_v > 0.0 {
+            last += 1;
+        }
+        let t0 = s[first].t_start;
+        let segments: Vec<Segment> = s[first..=last]
+            .iter()
+            .map(|g| Segment {
+                t_start: g.t_start - t0,
+                ..*g
+            })
+            .collect();
+        let end = segments.last().map_or(0.0, |g| g.t_start + g.duration());
+        Some(Plan {
+            segments,
+            print_time: end,
+        })
+    }
+
     /// `plan.csv`: one row per moving segment, columns
     /// `t_start,accel_t,cruise_t,decel_t,start_x,start_y,start_z,dir_x,dir_y,dir_z,start_v,cruise_v,end_v,accel`
     /// (s, m, unit vector, m/s, m/s²), start positions offset by `origin` [m]; every number in

@@ -13,6 +13,7 @@ mod rest;
 mod spatial;
 
 pub use rest::LoopError;
+pub use spatial::Path;
 
 use crate::controller::{self, AnyController, Controller, Reference, TensionLimits};
 use crate::model::CableModel;
@@ -20,7 +21,7 @@ use crate::robot::distribution::BOX_TOLERANCE;
 use crate::robot::{Effector, PerCable, Robot, Tensions, Vector};
 use crate::scenario::{ControllerKind, Scenario};
 use crate::shaper::Impulses;
-use crate::trajectory::{Segment, Step5};
+use crate::trajectory::Step5;
 use cdpr_numerics::OdeSystem;
 
 /// Where the commanded tensions come from.
@@ -63,9 +64,9 @@ pub struct ClosedLoop<M: CableModel<D>, const D: usize> {
     /// the scenario's shaper design is still "auto" (the runner refuses to run then).
     pub shaper: Option<Impulses>,
     pub controller: AnyController<D>,
-    /// A spatial robot's move (`trajectory.start` → `end`); None: the plane's x1 → x2 with
-    /// the other coordinates held.
-    pub path: Option<Segment<D>>,
+    /// A spatial robot's move (`trajectory.start` → `end`) or a print; None: the plane's
+    /// x1 → x2 with the other coordinates held.
+    pub path: Option<Path<D>>,
     pub limits: TensionLimits,
     pub actuation: Actuation,
     /// ΣT of the start equilibrium (MODELS.md §2) [N].
@@ -180,8 +181,12 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         }
     }
 
-    /// When the (shaped) reference reaches x2 [s]: t2 plus the shaper's duration.
+    /// When the (shaped) reference reaches x2 [s]: t2 plus the shaper's duration (a print:
+    /// when its shaped reference comes to rest).
     pub fn move_end(&self) -> f64 {
+        if let Some(Path::Print(print)) = &self.path {
+            return print.duration();
+        }
         self.trajectory.t2 + self.shaper.as_ref().map_or(0.0, Impulses::duration)
     }
 

@@ -8,12 +8,14 @@ use serde::Deserialize;
 
 mod controller;
 mod error;
+mod printer;
 mod spatial;
 mod validate;
 pub use controller::{Controller, ControllerKind, FlexCompensation};
 pub use error::{
     MAX_ELEMENTS, ScenarioError, count_in_range, finite, non_negative, out_of_range, positive,
 };
+pub use printer::{FirmwareShaper, Printer};
 
 use crate::shaper::{Impulses, ShaperKind};
 use std::path::Path;
@@ -367,6 +369,10 @@ pub struct Scenario {
     pub trajectory: Trajectory,
     pub simulation: Simulation,
     pub analysis: Analysis,
+    /// The printing firmware's limits and frame (`cargo xtask plan`, `print`); absent for a
+    /// robot that only makes moves.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub printer: Option<Printer>,
 }
 
 /// Fewest implicit steps over the move [t1, t2] ([`Scenario::largest_implicit_step`]).

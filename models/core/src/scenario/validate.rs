@@ -6,6 +6,9 @@ use super::*;
 impl Scenario {
     /// Checks every value against its physical range; the first violation is returned.
     pub fn validate(&self) -> Result<(), ScenarioError> {
+        if let Some(printer) = &self.printer {
+            printer.validate(if self.robot.anchors.is_some() { 3 } else { 2 })?;
+        }
         if self.robot.anchors.is_some() {
             return self.validate_spatial();
         }

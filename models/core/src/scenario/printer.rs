@@ -1,0 +1,165 @@
+//! `[printer]`: what the firmware of a printing robot is told (Klipper's `[printer]`,
+//! `[extruder]` and `[input_shaper]` sections, in SI) and where the G-code's coordinates sit in
+//! the robot's frame. Only `cargo xtask plan` and `print` read it.
+
+use super::{Designed, ScenarioError, finite, non_negative, out_of_range, positive};
+use cdpr_printing::planner::{ExtruderLimits, Limits};
+use serde::Deserialize;
+
+/// The input shaper a firmware applies per Cartesian axis (Klipper's names and definitions).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FirmwareShaper {
+    #[default]
+    None,
+    Zv,
+    Mzv,
+    Zvd,
+    Ei,
+    #[serde(rename = "2hump_ei")]
+    TwoHumpEi,
+    #[serde(rename = "3hump_ei")]
+    ThreeHumpEi,
+}
+
+/// `[printer]`; every key optional.
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Printer {
+    /// Where the file's (0, 0, 0) sits in the robot's frame [m]: [x, y, z], or [x, z] for the
+    /// planar robot, which prints the file's X and Z. Default: the origin.
+    pub origin: Vec<f64>,
+    /// max_velocity [m/s] (default 0.3).
+    pub max_velocity: f64,
+    /// max_accel [m/s²] (default 3; M204 in the file overrides it as in Klipper).
+    pub max_accel: f64,
+    /// square_corner_velocity [m/s] (Klipper: 0.005).
+    pub square_corner_velocity: f64,
+    /// minimum_cruise_ratio (Klipper: 0.5).
+    pub minimum_cruise_ratio: f64,
+    /// nozzle_diameter [m] (0.4 mm).
+    pub nozzle_diameter: f64,
+    /// filament_diameter [m] (1.75 mm).
+    pub filament_diameter: f64,
+    /// instantaneous_corner_velocity [m/s] (Klipper: 0.001).
+    pub instantaneous_corner_velocity: f64,
+    /// max_extrude_cross_section [m²] (Klipper: 4 nozzle_diameter²).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_extrude_cross_section: Option<f64>,
+    /// max_extrude_only_velocity [m/s] (Klipper: derived from max_velocity).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_extrude_only_velocity: Option<f64>,
+    /// max_extrude_only_accel [m/s²] (Klipper: derived from max_accel).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_extrude_only_accel: Option<f64>,
+    /// max_extrude_only_distance [m] (Klipper: 0.05).
+    pub max_extrude_only_distance: f64,
+    /// The input shaper of every axis (Klipper's `shaper_type`).
+    pub shaper: FirmwareShaper,
+    /// shaper_freq_x [Hz] or "auto" (from the robot's modes at the layer's centre).
+    pub shaper_freq_x: Designed,
+    /// shaper_freq_y [Hz] or "auto".
+    pub shaper_freq_y: Designed,
+    /// shaper_freq_z [Hz] or "auto".
+    pub shaper_freq_z: Designed,
+    /// damping_ratio of the shapers (Klipper: 0.1).
+    pub damping_ratio: f64,
+}
+
+impl Default for Printer {
+    fn default() -> Self {
+        let e = ExtruderLimits::default();
+        Printer {
+            origin: vec![0.0; 3],
+            max_velocity: 0.3,
+            max_accel: 3.0,
+            square_corner_velocity: 0.005,
+            minimum_cruise_ratio: 0.5,
+            nozzle_diameter: e.nozzle_diameter,
+            filament_diameter: e.filament_diameter,
+            instantaneous_corner_velocity: e.instantaneous_corner_velocity,
+            max_extrude_cross_section: None,
+            max_extrude_only_velocity: None,
+            max_extrude_only_accel: None,
+            max_extrude_only_distance: e.max_extrude_only_distance,
+            shaper: FirmwareShaper::None,
+            shaper_freq_x: Designed::default(),
+            shaper_freq_y: Designed::default(),
+            shaper_freq_z: Designed::default(),
+            damping_ratio: 0.1,
+        }
+    }
+}
+
+impl Printer {
+    /// The planner's limits.
+    pub fn limits(&self) -> Limits {
+        Limits {
+            max_velocity: self.max_velocity,
+            max_accel: self.max_accel,
+            square_corner_velocity: self.square_corner_velocity,
+            minimum_cruise_ratio: self.minimum_cruise_ratio,
+            extruder: ExtruderLimits {
+                nozzle_diameter: self.nozzle_diameter,
+                filament_diameter: self.filament_diameter,
+                max_extrude_cross_section: self.max_extrude_cross_section,
+                max_extrude_only_velocity: self.max_extrude_only_velocity,
+                max_extrude_only_accel: self.max_extrude_only_accel,
+                max_extrude_only_distance: self.max_extrude_only_distance,
+                instantaneous_corner_velocity: self.instantaneous_corner_velocity,
+            },
+        }
+    }
+
+    /// The origin as a 3-vector [m] (a planar robot's [x, z] with y = 0).
+    pub fn origin3(&self) -> [f64; 3] {
+        match self.origin.as_slice() {
+            [x, z] => [*x, 0.0, *z],
+            [x, y, z] => [*x, *y, *z],
+            _ => [0.0; 3],
+        }
+    }
+
+    /// Every key in range, for a robot of `dimension` (2: planar, 3: spatial).
+    pub fn validate(&self, dimension: usize) -> Result<(), ScenarioError> {
+        if self.origin.len() != dimension || !self.origin.iter().all(|v| v.is_finite()) {
+            let allowed = if dimension == 2 {
+                "[x, z] m (the planar robot prints the file's X and Z)"
+            } else {
+                "[x, y, z] m"
+            };
+            return Err(out_of_range(
+                "printer.origin",
+                format!("{:?}", self.origin),
+                allowed,
+            ));
+        }
+        self.limits().validate().map_err(|e| match e {
+            cdpr_printing::planner::PlanError::Limit {
+                key,
+                value,
+                allowed,
+            } => out_of_range(key, value, allowed),
+            other => out_of_range("printer", other.to_string(), "valid limits"),
+        })?;
+        non_negative("printer.damping_ratio", self.damping_ratio)?;
+        if self.damping_ratio >= 1.0 {
+            return Err(out_of_range(
+                "printer.damping_ratio",
+                self.damping_ratio,
+                "0 ≤ ζ < 1",
+            ));
+        }
+        for (key, f) in [
+            ("printer.shaper_freq_x", self.shaper_freq_x),
+            ("printer.shaper_freq_y", self.shaper_freq_y),
+            ("printer.shaper_freq_z", self.shaper_freq_z),
+        ] {
+            if let Designed::Value(hz) = f {
+                finite(key, hz)?;
+                positive(key, hz)?;
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,161 @@
+//! A print through a simulated printer: the slicer's G-code read and planned as the firmware
+//! does ([`cdpr_printing`]), the plan (the chosen layers) placed in the robot's frame and
+//! shaped per axis ([`PrintPath`]), checked for wrench feasibility, run through the robot's
+//! cable model and controller, and measured by its contour error ([`ContourMetrics`]).
+
+use crate::spatial::{check_feasible, loop_of, spatial_robot};
+use crate::study::Error;
+use cdpr_analysis::contour::ContourMetrics;
+use cdpr_core::closed_loop::Path;
+use cdpr_core::print_path::{AxisShaper, PrintPath};
+use cdpr_core::robot::Vector;
+use cdpr_core::runner::{Observer, Run, RunOptions, simulate_observed_reusing};
+use cdpr_core::scenario::{Designed, FirmwareShaper, Printer, Scenario, out_of_range};
+use cdpr_core::series::SeriesBuffer;
+use cdpr_printing::gcode::{self, Program};
+use cdpr_printing::planner::{self, Plan};
+use cdpr_printing::shaper::{Shaper, pulses};
+use std::ops::RangeInclusive;
+use std::sync::Arc;
+
+/// Time the loop runs on after the shaped reference has come to rest [s]: the ringing a
+/// print leaves once it stops.
+pub const SETTLE: f64 = 0.2;
+
+/// Reference instants per second checked for wrench feasibility (every millisecond: a
+/// segment of the plan lasts ≥ 2 ms at 10 000 mm/s² and 0.3 m/s).
+pub const FEASIBILITY_RATE: f64 = 1000.0;
+
+/// A print ready to run: the firmware's plan of the chosen layers and the robot's reference.
+#[derive(Debug, Clone)]
+pub struct PreparedPrint {
+    /// The file as read (skipped commands listed).
+    pub program: Program,
+    /// The whole file's plan.
+    pub plan: Plan,
+    /// The layers printed.
+    pub layers: RangeInclusive<usize>,
+    /// The reference: the layers' part of the plan, in the robot's frame, shaped.
+    pub path: Arc<PrintPath<3>>,
+}
+
+/// A print's run and its metrics.
+pub struct PrintRun {
+    pub run: Run,
+    pub contour: ContourMetrics,
+}
+
+/// Reads, plans and places `gcode` on the scenario's spatial robot (`[printer]`, or Klipper's
+/// defaults), the layers `layers` (all: `None`), and checks the reference's feasibility.
+pub fn prepare_print(
+    scenario: &Scenario,
+    gcode_text: &str,
+    layers: Option<RangeInclusive<usize>>,
+) -> Result<PreparedPrint, Error> {
+    let robot = spatial_robot(scenario)?;
+    let printer = scenario.printer.clone().unwrap_or_default();
+    let origin = printer.origin3();
+    let start = scenario
+        .trajectory
+        .start
+        .as_deref()
+        .map_or([0.0; 3], |s| [s[0], s[1], s[2]]);
+    // G28 brings the effector to its start pose: in the file's millimetres.
+    let home = [0, 1, 2].map(|k| (start[k] - origin[k]) * 1e3);
+    let program = gcode::read(gcode_text, home)?;
+    let plan = planner::plan(&program, &printer.limits())?;
+    let layers = layers.unwrap_or(0..=program.layers);
+    let selected = plan.select_layers(layers.clone()).ok_or_else(|| {
+        out_of_range(
+            "--layers",
+            format!("{}..{}", layers.start(), layers.end()),
+            format!("layers with moves among 0..{}", program.layers),
+        )
+    })?;
+    let shapers = axis_shapers(&printer)?;
+    let path =
+        PrintPath::new(Arc::new(selected), origin, shapers).expect("a selection has segments");
+    let rate = FEASIBILITY_RATE;
+    let n = (path.duration() * rate).ceil() as usize;
+    check_feasible(scenario, &robot, (0..=n).map(|k| k as f64 / rate), |t| {
+        let [p, _, a] = path.reference(t, true);
+        (p, a)
+    })?;
+    Ok(PreparedPrint {
+        program,
+        plan,
+        layers,
+        path: Arc::new(path),
+    })
+}
+
+/// The firmware's shaper of each axis (None when `[printer] shaper = "none"`).
+fn axis_shapers(printer: &Printer) -> Result<[Option<AxisShaper>; 3], Error> {
+    let shaper = match printer.shaper {
+        FirmwareShaper::None => return Ok([None, None, None]),
+        FirmwareShaper::Zv => Shaper::Zv,
+        FirmwareShaper::Mzv => Shaper::Mzv,
+        FirmwareShaper::Zvd => Shaper::Zvd,
+        FirmwareShaper::Ei => Shaper::Ei,
+        FirmwareShaper::TwoHumpEi => Shaper::TwoHumpEi,
+        FirmwareShaper::ThreeHumpEi => Shaper::ThreeHumpEi,
+    };
+    let axis = |key: &'static str, f: Designed| -> Result<Option<AxisShaper>, Error> {
+        match f {
+            Designed::Value(hz) => {
+                let (a, t) = pulses(shaper, hz, printer.damping_ratio);
+                Ok(Some(AxisShaper::from_pulses(&a, &t)))
+            }
+            Designed::Auto(_) => Err(out_of_range(
+                key,
+                "\"auto\"",
+                "a frequency [Hz] (`cargo xtask modes --at X,Y,Z` gives the robot's modes at \
+                 the layer's centre)",
+            )
+            .into()),
+        }
+    };
+    Ok([
+        axis("printer.shaper_freq_x", printer.shaper_freq_x)?,
+        axis("printer.shaper_freq_y", printer.shaper_freq_y)?,
+        axis("printer.shaper_freq_z", printer.shaper_freq_z)?,
+    ])
+}
+
+/// The run's options: the scenario's integrator and sampling, to the print's end and
+/// [`SETTLE`] after.
+pub fn print_options(scenario: &Scenario, print: &PreparedPrint) -> RunOptions {
+    RunOptions {
+        t_final: print.path.duration() + SETTLE,
+        ..RunOptions::from(scenario)
+    }
+}
+
+/// Runs the print, watched and steered by `observer`, and measures it.
+pub fn simulate_print(
+    scenario: &Scenario,
+    print: &PreparedPrint,
+    observer: &mut Observer,
+) -> Result<PrintRun, Error> {
+    let mut sys = loop_of(scenario, spatial_robot(scenario)?)?;
+    sys.path = Some(Path::Print(print.path.clone()));
+    let options = print_options(scenario, print);
+    let run = simulate_observed_reusing(&mut sys, &options, SeriesBuffer::default(), observer)?;
+    let contour = contour_of(print, &run);
+    Ok(PrintRun { run, contour })
+}
+
+/// The contour metrics of `run` (or of the part a failed run sampled).
+pub fn contour_of(print: &PreparedPrint, run: &Run) -> ContourMetrics {
+    use cdpr_core::channel::Channel;
+    let s = &run.series;
+    let column = |c: Channel| s.channel(c).unwrap_or(&[]);
+    let (t, x, y, z) = (
+        column(Channel::Time),
+        column(Channel::X),
+        column(Channel::Y),
+        column(Channel::Z),
+    );
+    let samples = (0..t.len()).map(|i| (t[i], Vector::<3>::new(x[i], y[i], z[i])));
+    ContourMetrics::of(&print.path, samples, print.layers.clone())
+}

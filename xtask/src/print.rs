@@ -1,0 +1,349 @@
+//! `cargo xtask plan` and `cargo xtask print`: a slicer's G-code through the firmware's planner
+//! (→ `plan.csv`), and through the simulated printer (→ `metrics.json` with the contour error
+//! overall and per move type, `print.csv`, a figure per layer). The print is checked before any
+//! work (the file, the limits, the reference's wrench feasibility), streams its rows to
+//! `print.partial.csv` as it runs, shows its progress with an ETA, and an interrupt or a failure
+//! keeps what it computed.
+
+use crate::output::{Progress, csv_row, write_atomic, write_json};
+use crate::simulate::{STOP, load_scenario, writable_out};
+use anyhow::{Context, Result, bail};
+use cdpr_bench::analysis::contour::{ContourMetrics, ErrorStats, contour_sample};
+use cdpr_bench::core::channel::Channel;
+use cdpr_bench::core::robot::Vector;
+use cdpr_bench::core::runner::{Observer, RunError};
+use cdpr_bench::printing::gcode::MoveKind;
+use cdpr_bench::printing::{gcode, planner};
+use cdpr_bench::{Error, PreparedPrint, Provenance};
+use cdpr_sweep::DirLock;
+use std::collections::BTreeMap;
+use std::io::{BufWriter, Write};
+use std::ops::RangeInclusive;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
+
+/// `plan.csv`.
+const PLAN: &str = "plan.csv";
+/// `print.csv` and its partial form while the print runs.
+const PRINT: &str = "print.csv";
+const PRINT_PARTIAL: &str = "print.partial.csv";
+
+/// `--layers A..B` (or a single layer `A`).
+pub fn parse_layers(text: &str) -> Result<RangeInclusive<usize>, String> {
+    let parse = |s: &str| {
+        s.trim()
+            .parse::<usize>()
+            .map_err(|_| format!("--layers {text}: `{s}` is not a layer number (0, 1, 2, …)"))
+    };
+    let (a, b) = match text.split_once("..") {
+        Some((a, b)) => (parse(a)?, parse(b.trim_start_matches('='))?),
+        None => (parse(text)?, parse(text)?),
+    };
+    if a > b {
+        return Err(format!(
+            "--layers {text}: the first layer must not follow the last"
+        ));
+    }
+    Ok(a..=b)
+}
+
+fn read_gcode(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).with_context(|| format!("reading --gcode {}", path.display()))
+}
+
+/// `cargo xtask plan`: the firmware's plan of the whole file in the robot's frame.
+pub fn plan(scenario: Option<&Path>, gcode_file: &Path, out: &Path) -> Result<()> {
+    let scenario = load_scenario(scenario, None)?;
+    let printer = scenario.printer.clone().unwrap_or_default();
+    let origin = printer.origin3();
+    let start = scenario
+        .trajectory
+        .start
+        .as_deref()
+        .map_or([0.0; 3], |s| [s[0], s[1], s[2]]);
+    let home = [0, 1, 2].map(|k| (start[k] - origin[k]) * 1e3);
+    let program = gcode::read(&read_gcode(gcode_file)?, home)
+        .with_context(|| format!("reading {}", gcode_file.display()))?;
+    let started = std::time::Instant::now();
+    let plan = planner::plan(&program, &printer.limits())?;
+    let planning = started.elapsed().as_secs_f64();
+    writable_out(out)?;
+    let csv = plan.csv(origin);
+    write_atomic(&out.join(PLAN), |w| w.write_all(csv.as_bytes()))?;
+    for s in &program.skipped {
+        eprintln!(
+            "skipped {} ({}×, first on line {})",
+            s.command, s.count, s.first_line
+        );
+    }
+    println!(
+        "{} segments over {} layers, print time {:.3} s, planned in {:.1} ms → {}",
+        plan.segments.len(),
+        program.layers,
+        plan.print_time,
+        planning * 1e3,
+        out.join(PLAN).display()
+    );
+    Ok(())
+}
+
+/// Where a print's channels sit in a run's row.
+struct Columns {
+    t: usize,
+    xyz: [usize; 3],
+    tensions: Vec<usize>,
+}
+
+/// `print.csv`, written as the print runs: t, reference, effector, contour error, tensions.
+struct PrintCsv {
+    writer: BufWriter<std::fs::File>,
+    path: PathBuf,
+    rows: usize,
+    every: usize,
+    error: Option<std::io::Error>,
+}
+
+impl PrintCsv {
+    fn create(path: PathBuf, cables: usize, every: usize) -> Result<Self> {
+        let file =
+            std::fs::File::create(&path).with_context(|| format!("creating {}", path.display()))?;
+        let mut writer = BufWriter::with_capacity(1 << 16, file);
+        let mut heading =
+            String::from("t [s],x_ref [m],y_ref [m],z_ref [m],x [m],y [m],z [m],contour_err [m]");
+        for i in 1..=cables {
+            heading.push_str(&format!(",T{i} [N]"));
+        }
+        writeln!(writer, "{heading}").with_context(|| format!("writing {}", path.display()))?;
+        Ok(PrintCsv {
+            writer,
+            path,
+            rows: 0,
+            every,
+            error: None,
+        })
+    }
+
+    fn push(&mut self, print: &PreparedPrint, columns: &Columns, row: &[f64]) {
+        if self.rows.is_multiple_of(self.every) && self.error.is_none() {
+            let t = row[columns.t];
+            let p = Vector::<3>::from_fn(|k, _| row[columns.xyz[k]]);
+            let reference = print.path.reference(t, false)[0];
+            let contour = contour_sample(&print.path, t, &p).error;
+            let mut values = vec![
+                t,
+                reference[0],
+                reference[1],
+                reference[2],
+                p[0],
+                p[1],
+                p[2],
+            ];
+            values.push(contour);
+            values.extend(columns.tensions.iter().map(|&i| row[i]));
+            let mut line = String::with_capacity(24 * values.len());
+            csv_row(&mut line, &values);
+            if let Err(e) = self.writer.write_all(line.as_bytes()) {
+                self.error = Some(e);
+                STOP.store(true, Ordering::Relaxed);
+            }
+        }
+        self.rows += 1;
+    }
+
+    fn finish(self, target: &Path) -> Result<()> {
+        if let Some(e) = self.error {
+            bail!("writing {}: {e}", self.path.display());
+        }
+        let path = self.path.clone();
+        self.writer
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .and_then(|f| f.sync_all())
+            .with_context(|| format!("writing {}", path.display()))?;
+        std::fs::rename(&path, target)
+            .with_context(|| format!("renaming into {}", target.display()))
+    }
+}
+
+/// `metrics.json` of a print.
+#[derive(serde::Serialize)]
+struct PrintMetricsFile<'a> {
+    status: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    error: Option<String>,
+    provenance: &'a Provenance,
+    gcode: String,
+    layers: [usize; 2],
+    segments: usize,
+    /// The firmware's print time of the printed part [s].
+    print_time_s: f64,
+    t_reached: f64,
+    #[serde(flatten)]
+    contour: BTreeMap<String, f64>,
+    samples: usize,
+    steps: u64,
+    rhs_evaluations: u64,
+    wall_s: f64,
+    units: BTreeMap<&'static str, &'static str>,
+}
+
+/// The contour and tracking statistics as flat keys: `contour_err_max`, …,
+/// `contour_err_max_external_perimeter`, …, `tracking_err_max`, ….
+fn flat(contour: &ContourMetrics) -> BTreeMap<String, f64> {
+    let mut out = BTreeMap::new();
+    let mut put = |prefix: &str, suffix: &str, s: &ErrorStats| {
+        out.insert(format!("{prefix}_max{suffix}"), s.max);
+        out.insert(format!("{prefix}_rms{suffix}"), s.rms);
+        out.insert(format!("{prefix}_p99{suffix}"), s.p99);
+    };
+    put("contour_err", "", &contour.overall);
+    for kind in MoveKind::ALL {
+        let stats = contour
+            .by_kind
+            .get(&kind)
+            .copied()
+            .unwrap_or(ErrorStats::of(&mut []));
+        put("contour_err", &format!("_{}", kind.name()), &stats);
+    }
+    put("tracking_err", "", &contour.tracking);
+    out
+}
+
+/// Options of `cargo xtask print`.
+pub struct PrintOptions<'a> {
+    pub scenario: &'a Path,
+    pub gcode: &'a Path,
+    pub layers: Option<RangeInclusive<usize>>,
+    pub out: &'a Path,
+    pub every: usize,
+}
+
+/// `cargo xtask print`.
+pub fn print(options: &PrintOptions) -> Result<()> {
+    let scenario = load_scenario(Some(options.scenario), None)?;
+    let text = read_gcode(options.gcode)?;
+    let prepared = cdpr_bench::prepare_print(&scenario, &text, options.layers.clone())
+        .with_context(|| format!("printing {}", options.gcode.display()))?;
+    let provenance = Provenance::of(&scenario)?;
+    let out = options.out;
+    writable_out(out)?;
+    let _lock = DirLock::acquire(out, "print")?;
+    for stale in [PRINT, PRINT_PARTIAL, crate::simulate::METRICS] {
+        let _ = std::fs::remove_file(out.join(stale));
+    }
+    let robot = cdpr_bench::spatial_robot(&scenario)?;
+    let model = cdpr_bench::elastic::Elastic::new(robot, scenario.cable.axial_stiffness());
+    let names = cdpr_bench::core::runner::channel_names(&model);
+    let index = |c: Channel| names.iter().position(|n| *n == c.name()).expect("channel");
+    let columns = Columns {
+        t: index(Channel::Time),
+        xyz: [index(Channel::X), index(Channel::Y), index(Channel::Z)],
+        tensions: (1..=robot.cables())
+            .map(|i| {
+                names
+                    .iter()
+                    .position(|n| *n == format!("T{i}"))
+                    .expect("tension")
+            })
+            .collect(),
+    };
+    ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
+        .context("installing the SIGINT/SIGTERM handler")?;
+    let mut csv = PrintCsv::create(out.join(PRINT_PARTIAL), robot.cables(), options.every)?;
+    let started = std::time::Instant::now();
+    let mut progress = Progress::new("print");
+    let result = {
+        let mut on_sample = |row: &[f64]| csv.push(&prepared, &columns, row);
+        let mut report = |f: f64| progress.set(f);
+        let mut observer = Observer {
+            progress: &mut report,
+            on_sample: Some(&mut on_sample),
+            stop: Some(&STOP),
+        };
+        cdpr_bench::simulate_print(&scenario, &prepared, &mut observer)
+    };
+    progress.finish();
+    let wall_s = started.elapsed().as_secs_f64();
+    let (run, status, error) = match result {
+        Ok(done) => (Some(done.run), "complete", None),
+        Err(Error::Run(failure)) => {
+            let status = match failure.error {
+                RunError::Interrupted { .. } => "interrupted",
+                _ => "failed",
+            };
+            (failure.partial, status, Some(failure.error.to_string()))
+        }
+        Err(e) => (None, "failed", Some(e.to_string())),
+    };
+    let error = csv
+        .error
+        .as_ref()
+        .map(|e| format!("writing {}: {e}", csv.path.display()))
+        .or(error);
+    let status = if csv.error.is_some() {
+        "failed"
+    } else {
+        status
+    };
+    if let Some(run) = &run {
+        // The rows of a failing step the stream has not seen.
+        let mut row = vec![0.0; run.series.width()];
+        for i in csv.rows..run.series.len() {
+            run.series.copy_row(i, &mut row);
+            csv.push(&prepared, &columns, &row);
+        }
+    }
+    let written = csv.finish(&out.join(PRINT));
+    let contour = run.as_ref().map(|r| cdpr_bench::contour_of(&prepared, r));
+    let plan = prepared.path.plan();
+    write_json(
+        &out.join(crate::simulate::METRICS),
+        &PrintMetricsFile {
+            status,
+            error: error.clone(),
+            provenance: &provenance,
+            gcode: options.gcode.display().to_string(),
+            layers: [*prepared.layers.start(), *prepared.layers.end()],
+            segments: plan.segments.len(),
+            print_time_s: plan.print_time,
+            t_reached: run.as_ref().map_or(0.0, |r| r.t_reached),
+            contour: contour.as_ref().map(flat).unwrap_or_default(),
+            samples: run.as_ref().map_or(0, |r| r.series.len()),
+            steps: run.as_ref().map_or(0, |r| r.stats.steps_accepted),
+            rhs_evaluations: run.as_ref().map_or(0, |r| r.stats.rhs_evals),
+            wall_s,
+            units: [
+                ("print_time_s", "s"),
+                ("t_reached", "s"),
+                ("wall_s", "s"),
+                ("contour_err_*", "m"),
+                ("tracking_err_*", "m"),
+            ]
+            .into_iter()
+            .collect(),
+        },
+    )?;
+    written?;
+    if let (Some(run), Some(contour)) = (&run, &contour) {
+        crate::print_figures::write(&prepared, run, out)?;
+        println!(
+            "{} segments, print time {:.2} s, simulated in {wall_s:.2} s: contour error max {:.1} µm, \
+             rms {:.1} µm, p99 {:.1} µm → {}",
+            plan.segments.len(),
+            plan.print_time,
+            contour.overall.max * 1e6,
+            contour.overall.rms * 1e6,
+            contour.overall.p99 * 1e6,
+            out.display()
+        );
+    }
+    match error {
+        None => Ok(()),
+        Some(e) => bail!(
+            "{e}; {status} print kept up to t = {} s in {} and {}",
+            run.as_ref().map_or(0.0, |r| r.t_reached),
+            out.join(PRINT).display(),
+            out.join(crate::simulate::METRICS).display()
+        ),
+    }
+}
