@@ -154,14 +154,16 @@ impl Reader {
     ) -> Result<(), GcodeError> {
         let mut percent = 100.0;
         for (letter, value) in line.parameters(number, text)? {
-            let value = required(number, text, letter, value)?;
-            match letter {
-                'S' if value <= 0.0 => {
-                    return Err(out_of_range(number, text, "S", value, "> 0 %"));
-                }
-                'S' => percent = value,
-                _ => {} // Marlin's B/R/D (backup, restore, tool): not Klipper's.
+            // Klipper reads S only: Marlin's B/R (backup, restore: flags without a value) and
+            // D (tool) are not Klipper's and are ignored as Klipper ignores them.
+            if letter != 'S' {
+                continue;
             }
+            let value = required(number, text, letter, value)?;
+            if value <= 0.0 {
+                return Err(out_of_range(number, text, "S", value, "> 0 %"));
+            }
+            percent = value;
         }
         if line.command == "M220" {
             let factor = percent / (60.0 * 100.0);
@@ -187,11 +189,6 @@ impl Reader {
     ) -> Result<Option<Instruction>, GcodeError> {
         let (mut s, mut p, mut t) = (None, None, None);
         for (letter, value) in line.parameters(number, text)? {
-            let value = required(number, text, letter, value)?;
-            if value <= 0.0 {
-                let key = letter.to_string();
-                return Err(out_of_range(number, text, &key, value, "> 0 mm/s²"));
-            }
             match letter {
                 'S' => s = Some(value),
                 'P' => p = Some(value),
@@ -199,12 +196,27 @@ impl Reader {
                 _ => {} // Marlin's R (retract acceleration) and the like: not Klipper's.
             }
         }
-        let accel = match (s, p, t) {
-            (Some(s), _, _) => s,
-            (None, Some(p), Some(t)) => p.min(t),
-            _ => {
-                self.skip(number, "M204 (without S, or P and T)");
-                return Ok(None);
+        let positive = |letter: char, value: Option<f64>| {
+            let value = required(number, text, letter, value)?;
+            if value <= 0.0 {
+                let key = letter.to_string();
+                return Err(out_of_range(number, text, &key, value, "> 0 mm/s²"));
+            }
+            Ok(value)
+        };
+        // Klipper's order: S, and only without S both P and T (each checked when given).
+        let accel = match s {
+            Some(s) => positive('S', s)?,
+            None => {
+                let p = p.map(|v| positive('P', v)).transpose()?;
+                let t = t.map(|v| positive('T', v)).transpose()?;
+                match (p, t) {
+                    (Some(p), Some(t)) => p.min(t),
+                    _ => {
+                        self.skip(number, "M204 (without S, or P and T)");
+                        return Ok(None);
+                    }
+                }
             }
         };
         Ok(Some(Instruction::Limits {

@@ -9,7 +9,7 @@
 //! by up to 7.6 µm). Positions are in the file's own axes (X, Y, Z, E); placing them in the
 //! robot's frame is the caller's business.
 //!
-//! Carried out: G0/G1 (X Y Z E F), G4 (P ms or S s), G21, G28 (to the home position the caller
+//! Carried out: G0/G1 (X Y Z E F), G4 (P ms), G21, G28 (to the home position the caller
 //! gives), G90/G91, G92, M82/M83, M204 (S, or P and T), M220/M221 (speed and extrusion
 //! overrides), M400/M109/M190 (wait for the moves: the toolhead stops), SET_VELOCITY_LIMIT.
 //! Refused by name: G2/G3 (arcs), G20 (inches), G10/G11 (firmware retraction), G4 S (Klipper
