@@ -120,6 +120,8 @@ pub fn contour_sample<const D: usize>(
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContourMetrics {
     pub overall: ErrorStats,
+    /// Over the moves that extrude (every kind but travel): the printed part's error.
+    pub printing: ErrorStats,
     pub by_kind: BTreeMap<MoveKind, ErrorStats>,
     pub tracking: ErrorStats,
 }
@@ -132,6 +134,7 @@ impl ContourMetrics {
         layers: std::ops::RangeInclusive<usize>,
     ) -> Self {
         let mut all = Vec::new();
+        let mut printing = Vec::new();
         let mut tracking = Vec::new();
         let mut by_kind: BTreeMap<MoveKind, Vec<f64>> = BTreeMap::new();
         for (t, p) in samples {
@@ -140,11 +143,15 @@ impl ContourMetrics {
                 continue;
             }
             all.push(c.error);
+            if c.kind != MoveKind::Travel {
+                printing.push(c.error);
+            }
             by_kind.entry(c.kind).or_default().push(c.error);
             tracking.push((path.reference(t, false)[0] - p).norm());
         }
         ContourMetrics {
             overall: ErrorStats::of(&mut all),
+            printing: ErrorStats::of(&mut printing),
             by_kind: by_kind
                 .into_iter()
                 .map(|(k, mut v)| (k, ErrorStats::of(&mut v)))

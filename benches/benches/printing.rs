@@ -54,9 +54,11 @@ fn cube_first_layer(c: &mut Criterion) {
     options.sample_period = options.t_final;
     let make = || {
         let robot = scenario.spatial_robot().unwrap();
-        let mut sys =
-            ClosedLoop::new(Elastic::new(robot, scenario.cable.axial_stiffness()), &scenario)
-                .unwrap();
+        let mut sys = ClosedLoop::new(
+            Elastic::new(robot, scenario.cable.axial_stiffness()),
+            &scenario,
+        )
+        .unwrap();
         sys.path = Some(LoopPath::Print(print.path.clone()));
         sys
     };
@@ -68,7 +70,13 @@ fn cube_first_layer(c: &mut Criterion) {
         run.stats.rhs_evals
     );
     group.bench_function("elastic_computed_torque_integration_only", |b| {
-        b.iter(|| black_box(simulate(&mut make(), &options, &mut |_| {}).unwrap().t_reached))
+        b.iter(|| {
+            black_box(
+                simulate(&mut make(), &options, &mut |_| {})
+                    .unwrap()
+                    .t_reached,
+            )
+        })
     });
 }
 

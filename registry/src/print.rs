@@ -102,6 +102,7 @@ fn axis_shapers(printer: &Printer) -> Result<[Option<AxisShaper>; 3], Error> {
     };
     let axis = |key: &'static str, f: Designed| -> Result<Option<AxisShaper>, Error> {
         match f {
+            Designed::Value(0.0) => Ok(None),
             Designed::Value(hz) => {
                 let (a, t) = pulses(shaper, hz, printer.damping_ratio);
                 Ok(Some(AxisShaper::from_pulses(&a, &t)))

@@ -23,6 +23,7 @@ pub mod modes;
 pub mod paper;
 pub mod paper_report;
 pub mod pool;
+pub mod print_study;
 pub mod samples;
 pub mod shaping;
 pub mod spatial_modes;

@@ -18,6 +18,7 @@ mod modes;
 mod output;
 mod print;
 mod print_figures;
+mod print_study;
 mod report;
 mod shaping;
 mod simulate;
@@ -179,6 +180,14 @@ enum Command {
         #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
         every: u64,
     },
+    /// The printer's speed–accuracy frontier: the first layers of the sliced cube and cylinder
+    /// on the Hangprinter-like robot at 1 000 … 10 000 mm/s², every controller unshaped and
+    /// best-shaped → DIR/print-study.json|md, DIR/print-frontier.svg|png.
+    PrintStudy {
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// A spatial robot's move (`[trajectory] start`, `end`) under every controller and every
     /// tension distribution → DIR/moves.json and DIR/moves.md (docs/spatial.md's table).
     SpatialMoves {
@@ -252,6 +261,7 @@ fn main() -> ExitCode {
         Command::Shaping { scenario, out } => shaping::run_study(scenario.as_deref(), &out),
         Command::Distribution { scenario, at, out } => distribution::run(&scenario, &at, &out),
         Command::SpatialMoves { scenario, out } => spatial_moves::run(&scenario, &out),
+        Command::PrintStudy { out } => print_study::run(&out),
         Command::Plan {
             scenario,
             gcode,

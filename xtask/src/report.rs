@@ -103,6 +103,13 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
         let figures = crate::sweep_study::write(&study, out)?;
         study_section.push_str(&study.section(&figures));
     }
+    // The printer's speed–accuracy frontier: 160 prints of two first layers (~30 s on two cores).
+    let printing = cdpr_studies::print_study::run(
+        &crate::print_study::printer_scenario()?,
+        &crate::print_study::parts()?,
+    )?;
+    crate::print_study::write(&printing, out)?;
+    study_section.push_str(&printing.section("print-frontier"));
     write_json(
         &out.join("metrics.json"),
         &ReportFile {

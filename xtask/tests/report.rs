@@ -7,7 +7,8 @@ use common::TempDir;
 use std::path::Path;
 use std::process::Command;
 
-const FIGURES: [&str; 9] = [
+const FIGURES: [&str; 10] = [
+    "print-frontier",
     "sweep_z_p2p",
     "sweep_err_transition",
     "sweep_shaper_z_p2p",

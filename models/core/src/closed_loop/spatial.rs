@@ -102,6 +102,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
     ) -> Result<(Vec<f64>, Equilibrium), LoopError> {
         let start = path.start();
         self.hold = Some(start);
+        self.controller.start_at(&start);
         // A controller designed at a point (the LQR) is designed at the end of the move.
         self.controller.hold_height(height(&path.end()))?;
         let reference = self.path_reference(path, 0.0);

@@ -10,8 +10,9 @@
 //! = "static"`, the firmware's), or of M (a_ref − g⃗) (`"dynamic"`); or, with `"none"`, the
 //! lengths at the start pose shifted by the geometric length change, l0_i(t) = l0_i(0) +
 //! l_i(p_ref(t)) − l_i(p_ref(0)). The cables then pull with what their strain gives: on the
-//! massless elastic cables T_i = max(0, EA (l_i(p) − l0_i)/l0_i) (eq. 1 solved for T; a
-//! slack cable pulls with nothing, and the run goes on), so this
+//! massless elastic cables T_i = max(0, EA (l_i(p) − l0_i)/l0_i + C (l̇_i − l̇0_i)/l0_i) (eq. 1
+//! solved for T, with the Kelvin–Voigt damping C of `[cable] axial_damping`; a slack cable
+//! pulls with nothing, and the run goes on), so this
 //! "controller" maps the measured pose to the cables' tensions the way the reels' lengths make
 //! them; nothing keeps them in the tension box, and the loop does not clamp them.
 
@@ -29,8 +30,11 @@ pub struct LengthControl<const D: usize> {
     pub flex: FlexCompensation,
     /// The distribution whose tensions the flex compensation assumes.
     pub solver: TensionSolver,
-    /// The reference's start pose [m] (the `"none"` compensation's calibration pose).
+    /// The reference's start pose [m] (the `"none"` compensation's calibration pose): the
+    /// scenario's, then where the loop starts ([`Controller::start_at`]).
     pub start: Vector<D>,
+    /// Kelvin–Voigt damping C of the cables [N s] (`[cable] axial_damping`).
+    pub axial_damping: f64,
 }
 
 impl<const D: usize> LengthControl<D> {
@@ -46,7 +50,24 @@ impl<const D: usize> LengthControl<D> {
             flex: scenario.controller.flex_compensation,
             solver: TensionSolver::from(&scenario.controller),
             start,
+            axial_damping: scenario.cable.axial_damping,
         }
+    }
+
+    /// The rates l̇0_i at which the reels pay out [m/s]: the chord's rate along the reference,
+    /// −u_i · ṗ_ref (u_i towards the anchor), scaled by 1/(1 + T_i/EA) under flex compensation (the change of T_i along the
+    /// path neglected: it moves l̇0 by T/EA ≲ 1e-3 of itself, the damping force by less).
+    fn reel_rates(&self, reference: &Reference<D>, l0: &PerCable) -> PerCable {
+        let r = &self.robot;
+        let p = reference.position;
+        PerCable::from_fn(r.cables(), |i| {
+            let c = r.chord(i, &p);
+            let geometric = -c.direction.dot(&reference.velocity);
+            match self.flex {
+                FlexCompensation::None => geometric,
+                _ => geometric * l0[i] / c.length,
+            }
+        })
     }
 
     /// The unstrained lengths l0_i the reels pay out for `reference` [m].
@@ -80,22 +101,37 @@ impl<const D: usize> Controller<D> for LengthControl<D> {
         0
     }
     fn uses_reference_derivatives(&self) -> bool {
-        self.flex == FlexCompensation::Dynamic
+        self.flex == FlexCompensation::Dynamic || self.axial_damping > 0.0
     }
     fn measures(&self) -> Measures {
         Measures {
             all_axes: true,
-            velocity: false,
+            velocity: self.axial_damping > 0.0,
         }
     }
-    /// The cables' tensions from their strain at the measured pose; the wrench is their pull.
+    fn start_at(&mut self, pose: &Vector<D>) {
+        self.start = *pose;
+    }
+    /// The cables' tensions from their strain (and strain rate) at the measured pose; the
+    /// wrench is their pull.
     fn output(&self, reference: &Reference<D>, effector: &Effector<D>, _: &[f64]) -> Output<D> {
         let l0 = self.reel_lengths(reference);
         let r = &self.robot;
+        let damped = self.axial_damping > 0.0;
+        let l0_rate = if damped {
+            self.reel_rates(reference, &l0)
+        } else {
+            PerCable::zeros(r.cables())
+        };
         let tensions = Tensions::from_fn(r.cables(), |i| {
-            let l = r.chord(i, &effector.position).length;
+            let c = r.chord(i, &effector.position);
+            let mut t = self.axial_stiffness * (c.length - l0[i]) / l0[i];
+            if damped {
+                let rate = -c.direction.dot(&effector.velocity);
+                t += self.axial_damping * (rate - l0_rate[i]) / l0[i];
+            }
             // A cable shorter than its unstrained length is slack: it cannot push.
-            (self.axial_stiffness * (l - l0[i]) / l0[i]).max(0.0)
+            t.max(0.0)
         });
         Output {
             wrench: r.structure_matrix(&effector.position).force(&tensions),

@@ -182,6 +182,10 @@ pub trait Controller<const D: usize>: Send + Sync + std::fmt::Debug {
         Ok(())
     }
 
+    /// Calibrates a controller to the pose [m] the loop starts at rest at (the length
+    /// controller's flex-none calibration: a print starts where its first layer begins).
+    fn start_at(&mut self, _pose: &Vector<D>) {}
+
     /// Named gains for the run's metrics (e.g. the LQR's K), row-major.
     fn gains(&self) -> Vec<(&'static str, Vec<f64>)> {
         Vec::new()
@@ -332,6 +336,9 @@ impl<const D: usize> Controller<D> for AnyController<D> {
     }
     fn hold_height(&mut self, z0: f64) -> Result<(), ControlError> {
         dispatch!(self, c => Controller::<D>::hold_height(c, z0))
+    }
+    fn start_at(&mut self, pose: &Vector<D>) {
+        dispatch!(self, c => Controller::<D>::start_at(c, pose))
     }
     fn gains(&self) -> Vec<(&'static str, Vec<f64>)> {
         dispatch!(self, c => Controller::<D>::gains(c))

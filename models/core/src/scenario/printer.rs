@@ -2,7 +2,7 @@
 //! `[extruder]` and `[input_shaper]` sections, in SI) and where the G-code's coordinates sit in
 //! the robot's frame. Only `cargo xtask plan` and `print` read it.
 
-use super::{Designed, ScenarioError, finite, non_negative, out_of_range, positive};
+use super::{Designed, ScenarioError, finite, non_negative, out_of_range};
 use cdpr_printing::planner::{ExtruderLimits, Limits};
 use serde::Deserialize;
 
@@ -56,7 +56,8 @@ pub struct Printer {
     pub max_extrude_only_distance: f64,
     /// The input shaper of every axis (Klipper's `shaper_type`).
     pub shaper: FirmwareShaper,
-    /// shaper_freq_x [Hz] or "auto" (from the robot's modes at the layer's centre).
+    /// shaper_freq_x [Hz] or "auto" (from the robot's modes at the layer's centre); 0 leaves
+    /// the axis unshaped (Klipper's convention).
     pub shaper_freq_x: Designed,
     /// shaper_freq_y [Hz] or "auto".
     pub shaper_freq_y: Designed,
@@ -157,7 +158,7 @@ impl Printer {
         ] {
             if let Designed::Value(hz) = f {
                 finite(key, hz)?;
-                positive(key, hz)?;
+                non_negative(key, hz)?;
             }
         }
         Ok(())

@@ -1,0 +1,410 @@
+//! The printer's speed–accuracy frontier (`cargo xtask print-study`, a section of REPORT.md):
+//! the first layer of the sliced 20 mm cube and cylinder printed by the Hangprinter-like robot
+//! at accelerations of 1 000 … 10 000 mm/s², under the reels driven by length as firmware does
+//! (flex compensation none or static, and dynamic) and under the tension controllers (computed-torque,
+//! LQR), each unshaped and with the best of Klipper's shapers at the frequencies of the loop's
+//! least-damped modes at the layer's centre ([`auto_frequencies`]). The answer to "at which
+//! acceleration does my print go wrong, and what buys it back" is each configuration's knee:
+//! the highest acceleration whose contour error over the printing moves (travel excluded: a
+//! travel's error draws nothing) stays within [`GOOD_CONTOUR`].
+
+use crate::spatial_modes::{SpatialLoop, SpatialModes, at_pose};
+use crate::{Result, pool};
+use cdpr_bench::core::runner::Observer;
+use cdpr_bench::core::scenario::{
+    AutoWord, ControllerKind, Designed, FirmwareShaper, FlexCompensation, Printer, Scenario,
+};
+use cdpr_bench::printing::gcode::MoveKind;
+use std::fmt::Write as _;
+use std::ops::RangeInclusive;
+
+/// The contour error a good first layer keeps [m] (an eighth of the 0.4 mm line width).
+pub const GOOD_CONTOUR: f64 = 50e-6;
+
+/// Printing accelerations [mm/s²] (M204's unit, the firmware's).
+pub const ACCELERATIONS: [f64; 4] = [1000.0, 3000.0, 6000.0, 10000.0];
+
+/// Klipper's shapers the best is chosen from (its calibration's usual three; ZVD and 2-hump EI
+/// won a few setups by < 10 % in a wider run and cost 40 % more prints).
+pub const SHAPERS: [FirmwareShaper; 3] =
+    [FirmwareShaper::Zv, FirmwareShaper::Mzv, FirmwareShaper::Ei];
+
+/// A controller configuration of the study.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Setup {
+    pub label: &'static str,
+    pub controller: ControllerKind,
+    pub flex: FlexCompensation,
+}
+
+/// Reels by length (flex none, static: as firmware; dynamic: the stretch under the reference's
+/// acceleration too), and the tension controllers.
+pub const SETUPS: [Setup; 5] = [
+    Setup {
+        label: "length, flex none",
+        controller: ControllerKind::Length,
+        flex: FlexCompensation::None,
+    },
+    Setup {
+        label: "length, flex static",
+        controller: ControllerKind::Length,
+        flex: FlexCompensation::Static,
+    },
+    Setup {
+        label: "length, flex dynamic",
+        controller: ControllerKind::Length,
+        flex: FlexCompensation::Dynamic,
+    },
+    Setup {
+        label: "computed-torque",
+        controller: ControllerKind::ComputedTorque,
+        flex: FlexCompensation::Static,
+    },
+    Setup {
+        label: "lqr",
+        controller: ControllerKind::Lqr,
+        flex: FlexCompensation::Static,
+    },
+];
+
+/// A part to print: its name, G-code and layers.
+#[derive(Debug, Clone)]
+pub struct Part {
+    pub name: String,
+    pub gcode: String,
+    pub layers: RangeInclusive<usize>,
+}
+
+/// One print of the study.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Row {
+    pub part: String,
+    pub setup: &'static str,
+    pub accel_mm_s2: f64,
+    /// "none" or Klipper's shaper name.
+    pub shaper: String,
+    /// The shaper's frequencies [Hz] (x, y; z unshaped).
+    pub shaper_freq_hz: [f64; 2],
+    pub print_time_s: f64,
+    /// Over the printing moves (travel excluded) [m].
+    pub contour_err_max_printing: f64,
+    pub contour_err_rms_printing: f64,
+    /// Over every move [m].
+    pub contour_err_max: f64,
+    pub contour_err_p99: f64,
+    pub contour_err_max_external_perimeter: f64,
+    pub tracking_err_max: f64,
+    pub steps: u64,
+    pub rhs_evaluations: u64,
+}
+
+/// The study's prints and the frequencies it shaped at.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct PrintStudy {
+    pub rows: Vec<Row>,
+}
+
+/// Per axis x, y, z: the frequency [Hz] of the loop's least-damped oscillatory mode whose
+/// motion is mostly along that axis (|direction_k| ≥ 1/2), from the closed-loop modes; where
+/// no mode is (a controller with equal gains on every axis has repeated modes, whose
+/// directions are any in their span), the least-damped oscillatory mode.
+pub fn auto_frequencies(modes: &SpatialModes) -> [Option<f64>; 3] {
+    let mut best: [Option<(f64, f64)>; 3] = [None; 3];
+    let mut any: Option<(f64, f64)> = None;
+    for m in modes
+        .modes
+        .iter()
+        .filter(|m| m.linearisation == SpatialLoop::Closed && m.omega_rad_s > 0.0)
+    {
+        let zeta = -m.growth / m.growth.hypot(m.omega_rad_s);
+        if any.is_none_or(|(z, _)| zeta < z) {
+            any = Some((zeta, m.omega_rad_s / (2.0 * std::f64::consts::PI)));
+        }
+        for (slot, along) in best.iter_mut().zip(m.direction) {
+            if along.abs() >= 0.5 && slot.is_none_or(|(z, _)| zeta < z) {
+                *slot = Some((zeta, m.omega_rad_s / (2.0 * std::f64::consts::PI)));
+            }
+        }
+    }
+    best.map(|b| b.or(any).map(|(_, hz)| hz))
+}
+
+/// Whether the scenario shapes an axis at an `"auto"` frequency.
+pub fn needs_auto(scenario: &Scenario) -> bool {
+    scenario.printer.as_ref().is_some_and(|p| {
+        p.shaper != FirmwareShaper::None
+            && [p.shaper_freq_x, p.shaper_freq_y, p.shaper_freq_z]
+                .into_iter()
+                .any(|f| matches!(f, Designed::Auto(_)))
+    })
+}
+
+/// The printing scenario with every `"auto"` shaper frequency resolved at `centre` [m]: the
+/// closed loop's modes there ([`auto_frequencies`]); an axis without such a mode is unshaped.
+pub fn resolve_auto(scenario: &Scenario, centre: [f64; 3]) -> Result<Scenario> {
+    let mut out = scenario.clone();
+    let Some(printer) = out.printer.as_mut() else {
+        return Ok(out);
+    };
+    let auto = |f: Designed| matches!(f, Designed::Auto(_));
+    if !needs_auto(scenario) {
+        return Ok(out);
+    }
+    let found = auto_frequencies(&at_pose(scenario, centre)?);
+    for (k, slot) in [
+        &mut printer.shaper_freq_x,
+        &mut printer.shaper_freq_y,
+        &mut printer.shaper_freq_z,
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        if auto(*slot) {
+            // No mode along the axis: unshaped (0, Klipper's convention).
+            *slot = Designed::Value(found[k].unwrap_or(0.0));
+        }
+    }
+    Ok(out)
+}
+
+/// The centre of the bounding box of `part`'s printed layers in the robot's frame [m].
+pub fn layer_centre(scenario: &Scenario, part: &Part) -> Result<[f64; 3]> {
+    let mut plain = scenario.clone();
+    if let Some(p) = plain.printer.as_mut() {
+        p.shaper = FirmwareShaper::None;
+    }
+    let print = cdpr_bench::prepare_print(&plain, &part.gcode, Some(part.layers.clone()))?;
+    let path = &print.path;
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for i in 0..path.plan().segments.len() {
+        if !part.layers.contains(&path.plan().segments[i].layer) {
+            continue;
+        }
+        let (a, b) = path.segment_ends(i);
+        for k in 0..3 {
+            lo[k] = lo[k].min(a[k]).min(b[k]);
+            hi[k] = hi[k].max(a[k]).max(b[k]);
+        }
+    }
+    Ok([0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k])))
+}
+
+/// One job: a part, a setup, an acceleration, a shaper.
+struct Job<'a> {
+    part: &'a Part,
+    setup: Setup,
+    accel: f64,
+    shaper: FirmwareShaper,
+}
+
+/// Runs the study on `base` (a printing robot's scenario) for `parts`.
+pub fn run(base: &Scenario, parts: &[Part]) -> Result<PrintStudy> {
+    let mut jobs = Vec::new();
+    for part in parts {
+        for setup in SETUPS {
+            for accel in ACCELERATIONS {
+                for shaper in std::iter::once(FirmwareShaper::None).chain(SHAPERS) {
+                    jobs.push(Job {
+                        part,
+                        setup,
+                        accel,
+                        shaper,
+                    });
+                }
+            }
+        }
+    }
+    // The shaper frequencies per part and setup (the modes depend on the controller).
+    let mut resolved = Vec::new();
+    for part in parts {
+        let centre = layer_centre(base, part)?;
+        for setup in SETUPS {
+            let mut s = configure(base, setup, ACCELERATIONS[0], FirmwareShaper::Zv);
+            s = resolve_auto(&s, centre)?;
+            let p = s.printer.as_ref().expect("configured");
+            resolved.push((
+                (part.name.clone(), setup.label),
+                [p.shaper_freq_x, p.shaper_freq_y],
+            ));
+        }
+    }
+    let rows = pool::map(&jobs, |job| -> Result<Row> {
+        let mut s = configure(base, job.setup, job.accel, job.shaper);
+        let freqs = resolved
+            .iter()
+            .find(|(key, _)| key.0 == job.part.name && key.1 == job.setup.label)
+            .map(|(_, f)| *f)
+            .expect("resolved per part and setup");
+        let printer = s.printer.as_mut().expect("configured");
+        (printer.shaper_freq_x, printer.shaper_freq_y) = (freqs[0], freqs[1]);
+        let print = cdpr_bench::prepare_print(&s, &job.part.gcode, Some(job.part.layers.clone()))?;
+        let run = cdpr_bench::simulate_print(&s, &print, &mut Observer::progress(&mut |_| {}))?;
+        let c = &run.contour;
+        let hz = |f: Designed| match f {
+            Designed::Value(v) => v,
+            Designed::Auto(_) => f64::NAN,
+        };
+        Ok(Row {
+            part: job.part.name.clone(),
+            setup: job.setup.label,
+            accel_mm_s2: job.accel,
+            shaper: shaper_name(job.shaper).to_string(),
+            shaper_freq_hz: if job.shaper == FirmwareShaper::None {
+                [f64::NAN; 2]
+            } else {
+                [hz(freqs[0]), hz(freqs[1])]
+            },
+            print_time_s: print.path.plan().print_time,
+            contour_err_max_printing: c.printing.max,
+            contour_err_rms_printing: c.printing.rms,
+            contour_err_max: c.overall.max,
+            contour_err_p99: c.overall.p99,
+            contour_err_max_external_perimeter: c
+                .by_kind
+                .get(&MoveKind::ExternalPerimeter)
+                .map_or(f64::NAN, |s| s.max),
+            tracking_err_max: c.tracking.max,
+            steps: run.run.stats.steps_accepted,
+            rhs_evaluations: run.run.stats.rhs_evals,
+        })
+    })?;
+    Ok(PrintStudy {
+        rows: rows.into_iter().collect::<Result<_>>()?,
+    })
+}
+
+/// `base` with the setup's controller, the printing acceleration and the shaper (frequencies
+/// "auto").
+fn configure(base: &Scenario, setup: Setup, accel: f64, shaper: FirmwareShaper) -> Scenario {
+    let mut s = base.clone();
+    s.controller.kind = setup.controller;
+    s.controller.flex_compensation = setup.flex;
+    let printer = s.printer.get_or_insert_with(Printer::default);
+    printer.max_accel = accel * 1e-3;
+    printer.shaper = shaper;
+    printer.shaper_freq_x = Designed::Auto(AutoWord::Auto);
+    printer.shaper_freq_y = Designed::Auto(AutoWord::Auto);
+    // The first layer moves in z only at its start: z stays unshaped.
+    printer.shaper_freq_z = Designed::Value(0.0);
+    s
+}
+
+/// Klipper's name of a shaper.
+pub fn shaper_name(shaper: FirmwareShaper) -> &'static str {
+    match shaper {
+        FirmwareShaper::None => "none",
+        FirmwareShaper::Zv => "zv",
+        FirmwareShaper::Mzv => "mzv",
+        FirmwareShaper::Zvd => "zvd",
+        FirmwareShaper::Ei => "ei",
+        FirmwareShaper::TwoHumpEi => "2hump_ei",
+        FirmwareShaper::ThreeHumpEi => "3hump_ei",
+    }
+}
+
+impl PrintStudy {
+    /// The report's section: what was printed, the frontier figure, the tables.
+    pub fn section(&self, figure: &str) -> String {
+        format!(
+            "## Printing: the speed–accuracy frontier\n\nBeyond the paper (`cargo xtask print-study`; \
+             print-study.json has every print): the first layer of a 20 mm cube and of a 20 mm \
+             cylinder sliced by PrusaSlicer 2.5.0 (verify/data/print), planned by Klipper's \
+             planner (300 mm/s, square corner velocity 5 mm/s) at each acceleration, printed by \
+             the Hangprinter-like robot (examples/printing/hangprinter.toml: elastic cables, \
+             line damping ζ = 2 % at the lowest locked-reel mode), each controller unshaped and \
+             with the best of Klipper's ZV, MZV and EI at the loop's least-damped modes at the \
+             layer's centre. Contour error: the nozzle's distance to the commanded path.\n\n\
+             ![{figure}]({figure}.svg)\n\n{}",
+            self.markdown()
+        )
+    }
+
+    /// The unshaped print and the best shaped one (lowest contour error) of a part, setup and
+    /// acceleration.
+    pub fn pair(&self, part: &str, setup: &str, accel: f64) -> Option<(&Row, &Row)> {
+        let mine = || {
+            self.rows
+                .iter()
+                .filter(move |r| r.part == part && r.setup == setup && r.accel_mm_s2 == accel)
+        };
+        let unshaped = mine().find(|r| r.shaper == "none")?;
+        let best = mine().filter(|r| r.shaper != "none").min_by(|a, b| {
+            a.contour_err_max_printing
+                .total_cmp(&b.contour_err_max_printing)
+        })?;
+        Some((unshaped, best))
+    }
+
+    /// The highest acceleration whose contour error stays within [`GOOD_CONTOUR`] (None: not
+    /// even the lowest), unshaped and best-shaped.
+    pub fn knee(&self, part: &str, setup: &str) -> [Option<f64>; 2] {
+        let mut knee = [None, None];
+        for accel in ACCELERATIONS {
+            if let Some((u, b)) = self.pair(part, setup, accel) {
+                for (slot, row) in knee.iter_mut().zip([u, b]) {
+                    if row.contour_err_max_printing <= GOOD_CONTOUR {
+                        *slot = Some(accel);
+                    }
+                }
+            }
+        }
+        knee
+    }
+
+    /// The study's tables: per part, each setup and acceleration unshaped and best-shaped,
+    /// then each setup's knee.
+    pub fn markdown(&self) -> String {
+        let mut md = String::new();
+        let mut parts: Vec<&str> = self.rows.iter().map(|r| r.part.as_str()).collect();
+        parts.dedup();
+        let um = |v: f64| format!("{:.1}", v * 1e6);
+        for part in parts {
+            let _ = writeln!(
+                md,
+                "**{part}** — contour error of the printing moves [µm] (max / rms; all moves' max, \
+                 travel included, in brackets) against print time [s]\n\n\
+                 | controller | accel [mm/s²] | print time | unshaped max | rms | best shaper (x, y Hz) | max | rms |\n\
+                 |---|---:|---:|---:|---:|---|---:|---:|"
+            );
+            for setup in SETUPS {
+                for accel in ACCELERATIONS {
+                    let Some((u, b)) = self.pair(part, setup.label, accel) else {
+                        continue;
+                    };
+                    let _ = writeln!(
+                        md,
+                        "| {} | {accel:.0} | {:.2} | {} ({}) | {} | {} ({:.1}, {:.1}) | {} ({}) | {} |",
+                        setup.label,
+                        u.print_time_s,
+                        um(u.contour_err_max_printing),
+                        um(u.contour_err_max),
+                        um(u.contour_err_rms_printing),
+                        b.shaper,
+                        b.shaper_freq_hz[0],
+                        b.shaper_freq_hz[1],
+                        um(b.contour_err_max_printing),
+                        um(b.contour_err_max),
+                        um(b.contour_err_rms_printing)
+                    );
+                }
+            }
+            let _ = writeln!(
+                md,
+                "\nKnee (highest acceleration with the printing moves' contour error ≤ {:.0} µm), \
+                 unshaped / best-shaped: {}\n",
+                GOOD_CONTOUR * 1e6,
+                SETUPS
+                    .iter()
+                    .map(|s| {
+                        let [u, b] = self.knee(part, s.label);
+                        let f =
+                            |k: Option<f64>| k.map_or("none".to_string(), |a| format!("{a:.0}"));
+                        format!("{} {} / {}", s.label, f(u), f(b))
+                    })
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            );
+        }
+        md
+    }
+}
