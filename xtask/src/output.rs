@@ -50,8 +50,9 @@ pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
     })
 }
 
-/// Progress of a long run: a bar on a terminal; elsewhere (CI logs, batch jobs) a plain line at
-/// every tenth of the work, so a log shows how far a run got.
+/// Progress of a long run: a bar with its ETA on a terminal; elsewhere (CI logs, batch jobs) a
+/// plain line at every tenth of the work with the time to go at the rate so far, so a log shows
+/// how far a run got and how long it will take.
 pub struct Progress {
     label: String,
     bar: Option<ProgressBar>,
@@ -87,11 +88,13 @@ impl Progress {
             Some(bar) => bar.set_position((done * 1000.0) as u64),
             None => {
                 while self.next_tenth <= 10 && done >= f64::from(self.next_tenth) / 10.0 {
+                    let elapsed = self.start.elapsed().as_secs_f64();
+                    // At the rate so far: elapsed × (1 − f) / f to go.
+                    let eta = elapsed * (1.0 - done) / done;
                     eprintln!(
-                        "{}: {} % after {:.1} s",
+                        "{}: {} % after {elapsed:.1} s, about {eta:.1} s to go",
                         self.label,
                         10 * self.next_tenth,
-                        self.start.elapsed().as_secs_f64()
                     );
                     self.next_tenth += 1;
                 }
