@@ -55,14 +55,7 @@ pub fn prepare_print(
     let robot = spatial_robot(scenario)?;
     let printer = scenario.printer.clone().unwrap_or_default();
     let origin = printer.origin3();
-    let start = scenario
-        .trajectory
-        .start
-        .as_deref()
-        .map_or([0.0; 3], |s| [s[0], s[1], s[2]]);
-    // G28 brings the effector to its start pose: in the file's millimetres.
-    let home = [0, 1, 2].map(|k| (start[k] - origin[k]) * 1e3);
-    let program = gcode::read(gcode_text, home)?;
+    let program = gcode::read(gcode_text, gcode_home(scenario))?;
     let plan = planner::plan(&program, &printer.limits())?;
     let layers = layers.unwrap_or(0..=program.layers);
     let selected = plan.select_layers(layers.clone()).ok_or_else(|| {
@@ -87,6 +80,32 @@ pub fn prepare_print(
         layers,
         path: Arc::new(path),
     })
+}
+
+/// Where G28 brings the effector, the robot's start pose (`[trajectory] start`, else the
+/// origin), in the file's millimetres.
+pub fn gcode_home(scenario: &Scenario) -> [f64; 3] {
+    let origin = scenario.printer.clone().unwrap_or_default().origin3();
+    let start = scenario
+        .trajectory
+        .start
+        .as_deref()
+        .map_or([0.0; 3], |s| [s[0], s[1], s[2]]);
+    [0, 1, 2].map(|k| (start[k] - origin[k]) * 1e3)
+}
+
+/// The run's samples: time [s] and effector position [m].
+pub fn positions(run: &Run) -> impl Iterator<Item = (f64, Vector<3>)> + '_ {
+    use cdpr_core::channel::Channel;
+    let s = &run.series;
+    let column = |c: Channel| s.channel(c).unwrap_or(&[]);
+    let (t, x, y, z) = (
+        column(Channel::Time),
+        column(Channel::X),
+        column(Channel::Y),
+        column(Channel::Z),
+    );
+    (0..t.len()).map(move |i| (t[i], Vector::<3>::new(x[i], y[i], z[i])))
 }
 
 /// The firmware's shaper of each axis (None when `[printer] shaper = "none"`).
@@ -148,15 +167,5 @@ pub fn simulate_print(
 
 /// The contour metrics of `run` (or of the part a failed run sampled).
 pub fn contour_of(print: &PreparedPrint, run: &Run) -> ContourMetrics {
-    use cdpr_core::channel::Channel;
-    let s = &run.series;
-    let column = |c: Channel| s.channel(c).unwrap_or(&[]);
-    let (t, x, y, z) = (
-        column(Channel::Time),
-        column(Channel::X),
-        column(Channel::Y),
-        column(Channel::Z),
-    );
-    let samples = (0..t.len()).map(|i| (t[i], Vector::<3>::new(x[i], y[i], z[i])));
-    ContourMetrics::of(&print.path, samples, print.layers.clone())
+    ContourMetrics::of(&print.path, positions(run), print.layers.clone())
 }

@@ -56,13 +56,7 @@ pub fn plan(scenario: Option<&Path>, gcode_file: &Path, out: &Path) -> Result<()
     let scenario = load_scenario(scenario, None)?;
     let printer = scenario.printer.clone().unwrap_or_default();
     let origin = printer.origin3();
-    let start = scenario
-        .trajectory
-        .start
-        .as_deref()
-        .map_or([0.0; 3], |s| [s[0], s[1], s[2]]);
-    let home = [0, 1, 2].map(|k| (start[k] - origin[k]) * 1e3);
-    let program = gcode::read(&read_gcode(gcode_file)?, home)
+    let program = gcode::read(&read_gcode(gcode_file)?, cdpr_bench::gcode_home(&scenario))
         .with_context(|| format!("reading {}", gcode_file.display()))?;
     let started = std::time::Instant::now();
     let plan = planner::plan(&program, &printer.limits())?;

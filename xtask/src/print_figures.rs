@@ -7,8 +7,6 @@ use crate::figures::{Drawing, register_fonts, render_drawing};
 use anyhow::Result;
 use cdpr_bench::PreparedPrint;
 use cdpr_bench::analysis::contour::contour_sample;
-use cdpr_bench::core::channel::Channel;
-use cdpr_bench::core::robot::Vector;
 use cdpr_bench::core::runner::Run;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -33,19 +31,8 @@ pub fn write(print: &PreparedPrint, run: &Run, out: &Path) -> Result<()> {
     register_fonts();
     let path = &print.path;
     let plan = path.plan();
-    let s = &run.series;
-    let column = |c: Channel| s.channel(c).unwrap_or(&[]);
-    let (t, x, y, z) = (
-        column(Channel::Time),
-        column(Channel::X),
-        column(Channel::Y),
-        column(Channel::Z),
-    );
-    let samples: Vec<_> = (0..t.len())
-        .map(|i| {
-            let p = Vector::<3>::new(x[i], y[i], z[i]);
-            (p, contour_sample(path, t[i], &p))
-        })
+    let samples: Vec<_> = cdpr_bench::positions(run)
+        .map(|(t, p)| (p, contour_sample(path, t, &p)))
         .collect();
     for layer in print.layers.clone() {
         let commanded: Vec<[(f64, f64); 2]> = (0..plan.segments.len())
