@@ -404,6 +404,57 @@ fn hangprinter_move_goals() {
     );
 }
 
+/// Reels driven by length report what they paid out: on the firmware's Hangprinter move a cable
+/// goes slack, and there its `l0` exceeds its chord (the reel paid out more than the chord
+/// takes up; l/(1 + T/EA) would say l0 = l); where taut and undamped, l0 = l/(1 + T/EA) to
+/// round-off (1e-12 relative). With the line's damping the tension includes C (l̇ − l̇0)/l0, and
+/// the channel still reports the reel's length, not l/(1 + T/EA).
+#[test]
+fn length_driven_reels_report_what_they_paid_out() {
+    for damping in [0.0, 8.5] {
+        let s = hangprinter(&format!(
+            "[controller]\nkind = \"length\"\n[cable]\naxial_damping = {damping}"
+        ));
+        let run = run_spatial(&s).unwrap().run;
+        let ea = s.cable.axial_stiffness();
+        let (mut slack, mut damped_off) = (0usize, 0.0f64);
+        for i in 1..=4 {
+            let t = run.series.channel_named(&format!("T{i}")).unwrap();
+            let l = run.series.channel_named(&format!("l{i}")).unwrap();
+            let l0 = run.series.channel_named(&format!("l0_{i}")).unwrap();
+            for k in 0..t.len() {
+                let strain_law = l[k] / (1.0 + t[k] / ea);
+                // (Damped, a line shortening fast goes slack while still stretched: the
+                // damper cannot push either.)
+                if t[k] == 0.0 && damping == 0.0 {
+                    slack += 1;
+                    assert!(
+                        l0[k] > l[k],
+                        "cable {i} slack at sample {k}: l0 {} ≤ l {}",
+                        l0[k],
+                        l[k]
+                    );
+                } else if damping == 0.0 {
+                    assert!(
+                        (l0[k] / strain_law - 1.0).abs() < 1e-12,
+                        "cable {i}, sample {k}"
+                    );
+                } else {
+                    damped_off = damped_off.max((l0[k] / strain_law - 1.0).abs());
+                }
+            }
+        }
+        if damping == 0.0 {
+            assert!(slack > 0, "the firmware's move lets a cable go slack");
+        } else {
+            assert!(
+                damped_off > 1e-9,
+                "the damped tension is not the strain's: {damped_off}"
+            );
+        }
+    }
+}
+
 /// Every example robot's own move (Hangprinter 4 cables; CoGiRo and IPAnema 8, IPAnema with
 /// t_min = 0 so that four cables rest idle at 0 N) under computed-torque with the exact QP: the
 /// path within 1 µm, every tension inside the file's box.

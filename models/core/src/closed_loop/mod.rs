@@ -190,6 +190,16 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         self.trajectory.t2 + self.shaper.as_ref().map_or(0.0, Impulses::duration)
     }
 
+    /// The unstrained lengths [m] the reels pay out at t [s] when the controller drives them
+    /// by length (the model's l0 channels then report these, not l/(1 + T/EA): a slack cable's
+    /// reel has paid out more than its chord, and a damped line's tension is not its strain's).
+    pub fn commanded_lengths(&self, t: f64) -> Option<crate::robot::PerCable> {
+        match self.actuation {
+            Actuation::Controller => self.controller.reel_lengths_for(&self.reference(t)),
+            Actuation::Prescribed(_) => None,
+        }
+    }
+
     /// The held start height z0 [m], once [`ClosedLoop::initial_state`] has found it.
     pub fn hold_height(&self) -> Option<f64> {
         self.hold.map(|h| crate::robot::height(&h))

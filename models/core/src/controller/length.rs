@@ -112,6 +112,9 @@ impl<const D: usize> Controller<D> for LengthControl<D> {
     fn start_at(&mut self, pose: &Vector<D>) {
         self.start = *pose;
     }
+    fn reel_lengths_for(&self, reference: &Reference<D>) -> Option<PerCable> {
+        Some(self.reel_lengths(reference))
+    }
     /// The cables' tensions from their strain (and strain rate) at the measured pose; the
     /// wrench is their pull.
     fn output(&self, reference: &Reference<D>, effector: &Effector<D>, _: &[f64]) -> Output<D> {

@@ -186,6 +186,13 @@ pub trait Controller<const D: usize>: Send + Sync + std::fmt::Debug {
     /// controller's flex-none calibration: a print starts where its first layer begins).
     fn start_at(&mut self, _pose: &Vector<D>) {}
 
+    /// The unstrained lengths l0_i [m] the reels pay out for `reference`, for a controller
+    /// that drives its reels by length (None: the reels pull with commanded tensions, and the
+    /// model derives l0 from them).
+    fn reel_lengths_for(&self, _reference: &Reference<D>) -> Option<crate::robot::PerCable> {
+        None
+    }
+
     /// Named gains for the run's metrics (e.g. the LQR's K), row-major.
     fn gains(&self) -> Vec<(&'static str, Vec<f64>)> {
         Vec::new()
@@ -339,6 +346,9 @@ impl<const D: usize> Controller<D> for AnyController<D> {
     }
     fn start_at(&mut self, pose: &Vector<D>) {
         dispatch!(self, c => Controller::<D>::start_at(c, pose))
+    }
+    fn reel_lengths_for(&self, reference: &Reference<D>) -> Option<crate::robot::PerCable> {
+        dispatch!(self, c => Controller::<D>::reel_lengths_for(c, reference))
     }
     fn gains(&self) -> Vec<(&'static str, Vec<f64>)> {
         dispatch!(self, c => Controller::<D>::gains(c))

@@ -269,6 +269,12 @@ fn integrate_and_sample<M: CableModel<D>, const D: usize>(
         series: TimeSeries::with_buffer(names, samples, buffer),
         y: vec![0.0; y0.len()],
         model_channels: sys.model.channel_names().len(),
+        l0_channels: (1..=sys.model.cables())
+            .filter_map(|i| {
+                let name = format!("l0_{i}");
+                sys.model.channel_names().iter().position(|c| *c == name)
+            })
+            .collect(),
         energy0: sys.model.energy(&y0[..n]).total(),
         event_energy: 0.0,
         next: 0,

@@ -15,6 +15,8 @@ pub(super) struct Sampler {
     pub(super) y: Vec<f64>,
     /// Number of the model's own channels.
     pub(super) model_channels: usize,
+    /// Where the model's channels `l0_1` … `l0_m` sit among them (empty when it has none).
+    pub(super) l0_channels: Vec<usize>,
     pub(super) energy0: f64,
     /// Sum of the energy changes of the model events so far [J].
     pub(super) event_energy: f64,
@@ -68,6 +70,11 @@ impl Sampler {
             let residual = energy.total() - self.energy0 - work + dissipated - self.event_energy;
             let m = self.model_channels;
             let cables = cmd.tensions.len();
+            let paid_out = if self.l0_channels.len() == cables {
+                sys.commanded_lengths(tk)
+            } else {
+                None
+            };
             let flag = usize::from(D == 3);
             self.series.push_row_with(|row| {
                 let (common, rest) = row.split_at_mut(4 + D + cables + flag);
@@ -82,6 +89,11 @@ impl Sampler {
                     common[4 + D + cables] = f64::from(u8::from(cmd.saturated));
                 }
                 sys.model.channels(model_state, &cmd.tensions, own);
+                if let Some(l0) = &paid_out {
+                    for (k, &at) in self.l0_channels.iter().enumerate() {
+                        own[at] = l0[k];
+                    }
+                }
                 energies.copy_from_slice(&[
                     energy.kinetic,
                     energy.elastic,
