@@ -12,6 +12,7 @@ use cdpr_bench::analysis::contour::{ContourMetrics, ErrorStats, contour_sample};
 use cdpr_bench::core::channel::Channel;
 use cdpr_bench::core::robot::Vector;
 use cdpr_bench::core::runner::{Observer, RunError};
+use cdpr_bench::core::scenario::Scenario;
 use cdpr_bench::printing::gcode::MoveKind;
 use cdpr_bench::printing::{gcode, planner};
 use cdpr_bench::{Error, PreparedPrint, Provenance};
@@ -215,23 +216,7 @@ pub struct PrintOptions<'a> {
 
 /// `cargo xtask print`.
 pub fn print(options: &PrintOptions) -> Result<()> {
-    let scenario = load_scenario(Some(options.scenario), None)?;
-    let text = read_gcode(options.gcode)?;
-    // `shaper_freq_* = "auto"`: the closed loop's modes at the printed layers' centre.
-    let scenario = if cdpr_studies::print_study::needs_auto(&scenario) {
-        let part = cdpr_studies::print_study::Part {
-            name: options.gcode.display().to_string(),
-            gcode: text.clone(),
-            layers: options.layers.clone().unwrap_or(0..=usize::MAX),
-        };
-        let centre = cdpr_studies::print_study::layer_centre(&scenario, &part)
-            .with_context(|| format!("printing {}", options.gcode.display()))?;
-        cdpr_studies::print_study::resolve_auto(&scenario, centre)?
-    } else {
-        scenario
-    };
-    let prepared = cdpr_bench::prepare_print(&scenario, &text, options.layers.clone())
-        .with_context(|| format!("printing {}", options.gcode.display()))?;
+    let (scenario, prepared) = prepare(options)?;
     let provenance = Provenance::of(&scenario)?;
     let out = options.out;
     writable_out(out)?;
@@ -239,36 +224,112 @@ pub fn print(options: &PrintOptions) -> Result<()> {
     for stale in [PRINT, PRINT_PARTIAL, crate::simulate::METRICS] {
         let _ = std::fs::remove_file(out.join(stale));
     }
-    let robot = cdpr_bench::spatial_robot(&scenario)?;
+    let ended = run_streamed(&scenario, &prepared, out, options.every)?;
+    let plan = prepared.path.plan();
+    let contour = ended
+        .run
+        .as_ref()
+        .map(|r| cdpr_bench::contour_of(&prepared, r));
+    write_metrics(options, &provenance, &prepared, &ended, contour.as_ref())?;
+    ended.written?;
+    if let (Some(run), Some(contour)) = (&ended.run, &contour) {
+        crate::print_figures::write(&prepared, run, out)?;
+        println!(
+            "{} segments, print time {:.2} s, simulated in {:.2} s: contour error of the \
+             printing moves max {:.1} µm, rms {:.1} µm (all moves max {:.1} µm) → {}",
+            plan.segments.len(),
+            plan.print_time,
+            ended.wall_s,
+            contour.printing.max * 1e6,
+            contour.printing.rms * 1e6,
+            contour.overall.max * 1e6,
+            out.display()
+        );
+    }
+    match ended.error {
+        None => Ok(()),
+        Some(e) => bail!(
+            "{e}; {} print kept up to t = {} s in {} and {}",
+            ended.status,
+            ended.run.as_ref().map_or(0.0, |r| r.t_reached),
+            out.join(PRINT).display(),
+            out.join(crate::simulate::METRICS).display()
+        ),
+    }
+}
+
+/// The scenario (its `"auto"` shaper frequencies resolved at the printed layers' centre) and
+/// the print, checked before anything is written.
+fn prepare(options: &PrintOptions) -> Result<(Scenario, PreparedPrint)> {
+    let scenario = load_scenario(Some(options.scenario), None)?;
+    let text = read_gcode(options.gcode)?;
+    let printing = || format!("printing {}", options.gcode.display());
+    let scenario = if cdpr_studies::print_study::needs_auto(&scenario) {
+        let part = cdpr_studies::print_study::Part {
+            name: options.gcode.display().to_string(),
+            gcode: text.clone(),
+            layers: options.layers.clone().unwrap_or(0..=usize::MAX),
+        };
+        let centre =
+            cdpr_studies::print_study::layer_centre(&scenario, &part).with_context(printing)?;
+        cdpr_studies::print_study::resolve_auto(&scenario, centre)?
+    } else {
+        scenario
+    };
+    let prepared = cdpr_bench::prepare_print(&scenario, &text, options.layers.clone())
+        .with_context(printing)?;
+    Ok((scenario, prepared))
+}
+
+/// Where the print's channels sit in the run's row.
+fn columns(scenario: &Scenario) -> Result<(Columns, usize)> {
+    let robot = cdpr_bench::spatial_robot(scenario)?;
     let model = cdpr_bench::elastic::Elastic::new(robot, scenario.cable.axial_stiffness());
     let names = cdpr_bench::core::runner::channel_names(&model);
-    let index = |c: Channel| names.iter().position(|n| *n == c.name()).expect("channel");
+    let index = |name: &str| names.iter().position(|n| n == name).expect("channel");
     let columns = Columns {
-        t: index(Channel::Time),
-        xyz: [index(Channel::X), index(Channel::Y), index(Channel::Z)],
+        t: index(&Channel::Time.name()),
+        xyz: [Channel::X, Channel::Y, Channel::Z].map(|c| index(&c.name())),
         tensions: (1..=robot.cables())
-            .map(|i| {
-                names
-                    .iter()
-                    .position(|n| *n == format!("T{i}"))
-                    .expect("tension")
-            })
+            .map(|i| index(&format!("T{i}")))
             .collect(),
     };
+    Ok((columns, robot.cables()))
+}
+
+/// How a print ended: what it computed (all, or what a failed or interrupted run sampled),
+/// "complete" | "interrupted" | "failed", why, its wall time, and whether print.csv was written.
+struct Ended {
+    run: Option<cdpr_bench::core::runner::Run>,
+    status: &'static str,
+    error: Option<String>,
+    wall_s: f64,
+    written: Result<()>,
+}
+
+/// Runs the print with its rows streamed to `print.partial.csv` (renamed to `print.csv` at the
+/// end, whatever the ending), its progress shown, SIGINT/SIGTERM honoured.
+fn run_streamed(
+    scenario: &Scenario,
+    prepared: &PreparedPrint,
+    out: &Path,
+    every: usize,
+) -> Result<Ended> {
+    let (columns, cables) = columns(scenario)?;
     ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
         .context("installing the SIGINT/SIGTERM handler")?;
-    let mut csv = PrintCsv::create(out.join(PRINT_PARTIAL), robot.cables(), options.every)?;
+    let mut csv = PrintCsv::create(out.join(PRINT_PARTIAL), cables, every)?;
     let started = std::time::Instant::now();
     let mut progress = Progress::new("print");
     let result = {
-        let mut on_sample = |row: &[f64]| csv.push(&prepared, &columns, row);
+        let mut on_sample = |row: &[f64]| csv.push(prepared, &columns, row);
         let mut report = |f: f64| progress.set(f);
         let mut observer = Observer {
             progress: &mut report,
             on_sample: Some(&mut on_sample),
             stop: Some(&STOP),
         };
-        cdpr_bench::simulate_print(&scenario, &prepared, &mut observer)
+        cdpr_bench::simulate_print(scenario, prepared, &mut observer)
     };
     progress.finish();
     let wall_s = started.elapsed().as_secs_f64();
@@ -283,12 +344,12 @@ pub fn print(options: &PrintOptions) -> Result<()> {
         }
         Err(e) => (None, "failed", Some(e.to_string())),
     };
-    let error = csv
+    // A failed write fails the print whatever it did.
+    let write_error = csv
         .error
         .as_ref()
-        .map(|e| format!("writing {}: {e}", csv.path.display()))
-        .or(error);
-    let status = if csv.error.is_some() {
+        .map(|e| format!("writing {}: {e}", csv.path.display()));
+    let status = if write_error.is_some() {
         "failed"
     } else {
         status
@@ -298,28 +359,44 @@ pub fn print(options: &PrintOptions) -> Result<()> {
         let mut row = vec![0.0; run.series.width()];
         for i in csv.rows..run.series.len() {
             run.series.copy_row(i, &mut row);
-            csv.push(&prepared, &columns, &row);
+            csv.push(prepared, &columns, &row);
         }
     }
-    let written = csv.finish(&out.join(PRINT));
-    let contour = run.as_ref().map(|r| cdpr_bench::contour_of(&prepared, r));
+    Ok(Ended {
+        run,
+        status,
+        error: write_error.or(error),
+        wall_s,
+        written: csv.finish(&out.join(PRINT)),
+    })
+}
+
+/// `metrics.json` of a print's ending.
+fn write_metrics(
+    options: &PrintOptions,
+    provenance: &Provenance,
+    prepared: &PreparedPrint,
+    ended: &Ended,
+    contour: Option<&ContourMetrics>,
+) -> Result<()> {
     let plan = prepared.path.plan();
+    let run = ended.run.as_ref();
     write_json(
-        &out.join(crate::simulate::METRICS),
+        &options.out.join(crate::simulate::METRICS),
         &PrintMetricsFile {
-            status,
-            error: error.clone(),
-            provenance: &provenance,
+            status: ended.status,
+            error: ended.error.clone(),
+            provenance,
             gcode: options.gcode.display().to_string(),
             layers: [*prepared.layers.start(), *prepared.layers.end()],
             segments: plan.segments.len(),
             print_time_s: plan.print_time,
-            t_reached: run.as_ref().map_or(0.0, |r| r.t_reached),
-            contour: contour.as_ref().map(flat).unwrap_or_default(),
-            samples: run.as_ref().map_or(0, |r| r.series.len()),
-            steps: run.as_ref().map_or(0, |r| r.stats.steps_accepted),
-            rhs_evaluations: run.as_ref().map_or(0, |r| r.stats.rhs_evals),
-            wall_s,
+            t_reached: run.map_or(0.0, |r| r.t_reached),
+            contour: contour.map(flat).unwrap_or_default(),
+            samples: run.map_or(0, |r| r.series.len()),
+            steps: run.map_or(0, |r| r.stats.steps_accepted),
+            rhs_evaluations: run.map_or(0, |r| r.stats.rhs_evals),
+            wall_s: ended.wall_s,
             units: [
                 ("print_time_s", "s"),
                 ("t_reached", "s"),
@@ -330,28 +407,5 @@ pub fn print(options: &PrintOptions) -> Result<()> {
             .into_iter()
             .collect(),
         },
-    )?;
-    written?;
-    if let (Some(run), Some(contour)) = (&run, &contour) {
-        crate::print_figures::write(&prepared, run, out)?;
-        println!(
-            "{} segments, print time {:.2} s, simulated in {wall_s:.2} s: contour error of the \
-             printing moves max {:.1} µm, rms {:.1} µm (all moves max {:.1} µm) → {}",
-            plan.segments.len(),
-            plan.print_time,
-            contour.printing.max * 1e6,
-            contour.printing.rms * 1e6,
-            contour.overall.max * 1e6,
-            out.display()
-        );
-    }
-    match error {
-        None => Ok(()),
-        Some(e) => bail!(
-            "{e}; {status} print kept up to t = {} s in {} and {}",
-            run.as_ref().map_or(0.0, |r| r.t_reached),
-            out.join(PRINT).display(),
-            out.join(crate::simulate::METRICS).display()
-        ),
-    }
+    )
 }
