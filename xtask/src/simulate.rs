@@ -282,43 +282,7 @@ pub fn run(
     let result = streamed(&mut stream, kind.name(), |observer| {
         cdpr_bench::assess_observed(&scenario, observer)
     });
-    let write_failure = stream.failure();
-    let (assessed, ending) = match result {
-        Ok(assessed) => (
-            Some(assessed),
-            Ending {
-                status: "complete",
-                error: None,
-            },
-        ),
-        Err(Error::Run(failure)) => {
-            let ending = match (&write_failure, &failure.error) {
-                (Some(e), _) => Ending {
-                    status: "failed",
-                    error: Some(e.clone()),
-                },
-                (None, RunError::Interrupted { .. }) => Ending {
-                    status: "interrupted",
-                    error: Some(failure.error.to_string()),
-                },
-                (None, e) => Ending {
-                    status: "failed",
-                    error: Some(e.to_string()),
-                },
-            };
-            let assessed = failure
-                .partial
-                .map(|run| Assessed::partial(&scenario, kind, run));
-            (assessed, ending)
-        }
-        Err(e) => (
-            None,
-            Ending {
-                status: "failed",
-                error: Some(e.to_string()),
-            },
-        ),
-    };
+    let (assessed, ending) = ending(&scenario, kind, result, stream.failure());
     let written = match &assessed {
         Some(a) => stream.finish(&a.run.series, &out.join(TIMESERIES)),
         None => stream.finish(
@@ -340,6 +304,44 @@ pub fn run(
             out.join(TIMESERIES).display(),
             out.join(METRICS).display()
         ),
+    }
+}
+
+/// What a run left (all of it, or what a failed or interrupted run sampled) and how it ended;
+/// a failed write of the samples fails the run whatever it did.
+fn ending(
+    scenario: &Scenario,
+    kind: ModelKind,
+    result: Result<Assessed, Error>,
+    write_failure: Option<String>,
+) -> (Option<Assessed>, Ending) {
+    let failed = |error: String| Ending {
+        status: "failed",
+        error: Some(error),
+    };
+    match result {
+        Ok(assessed) => (
+            Some(assessed),
+            Ending {
+                status: "complete",
+                error: None,
+            },
+        ),
+        Err(Error::Run(failure)) => {
+            let ending = match (&write_failure, &failure.error) {
+                (Some(e), _) => failed(e.clone()),
+                (None, RunError::Interrupted { .. }) => Ending {
+                    status: "interrupted",
+                    error: Some(failure.error.to_string()),
+                },
+                (None, e) => failed(e.to_string()),
+            };
+            let assessed = failure
+                .partial
+                .map(|run| Assessed::partial(scenario, kind, run));
+            (assessed, ending)
+        }
+        Err(e) => (None, failed(e.to_string())),
     }
 }
 
