@@ -57,6 +57,65 @@ pub enum Bound {
     Max,
 }
 
+/// The cables a method fixed at a bound, in order: at most one per cable, held inline so that a
+/// distribution on the right-hand side's path allocates nothing. Reads as a slice.
+#[derive(Clone, Copy)]
+pub struct Clamped {
+    items: [(CableId, Bound); MAX_CABLES],
+    len: usize,
+}
+
+impl Clamped {
+    /// None clamped.
+    pub const fn new() -> Self {
+        Clamped {
+            items: [(CableId(0), Bound::Min); MAX_CABLES],
+            len: 0,
+        }
+    }
+
+    /// Appends a cable (at most [`MAX_CABLES`]: one entry per cable).
+    pub fn push(&mut self, item: (CableId, Bound)) {
+        self.items[self.len] = item;
+        self.len += 1;
+    }
+}
+
+impl Default for Clamped {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl std::ops::Deref for Clamped {
+    type Target = [(CableId, Bound)];
+    fn deref(&self) -> &Self::Target {
+        &self.items[..self.len]
+    }
+}
+
+impl PartialEq for Clamped {
+    fn eq(&self, other: &Self) -> bool {
+        **self == **other
+    }
+}
+
+impl std::fmt::Debug for Clamped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
+    }
+}
+
+impl FromIterator<(CableId, Bound)> for Clamped {
+    fn from_iter<I: IntoIterator<Item = (CableId, Bound)>>(iter: I) -> Self {
+        let mut c = Clamped::new();
+        for item in iter {
+            c.push(item);
+        }
+        c
+    }
+}
+
 /// The tension box [t_min, t_max] every cable shares [N].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TensionBox {
@@ -90,7 +149,7 @@ pub struct Distribution {
     pub feasible: bool,
     /// The cables the method fixed at a bound, in clamping order (the improved closed form's;
     /// the QP's active set, cable order; empty for the others).
-    pub clamped: Vec<(CableId, Bound)>,
+    pub clamped: Clamped,
 }
 
 /// Why no distribution could be computed at all.
@@ -124,7 +183,7 @@ pub fn distribute<const D: usize>(
             Ok(Distribution {
                 tensions,
                 feasible,
-                clamped: Vec::new(),
+                clamped: Clamped::new(),
             })
         }
         DistributionMethod::ImprovedClosedForm => improved_closed_form(w, wrench, limits),
@@ -220,7 +279,7 @@ fn improved_closed_form<const D: usize>(
     let mut free = [true; MAX_CABLES];
     let mut fixed = Tensions::zeros(m);
     let mut remaining = *wrench;
-    let mut clamped = Vec::new();
+    let mut clamped = Clamped::new();
     loop {
         let Some(solved) = closed_form(w, &free[..m], &remaining, limits.middle()) else {
             if clamped.is_empty() {
@@ -308,7 +367,7 @@ fn puncture<const D: usize>(
     Ok(Distribution {
         tensions,
         feasible,
-        clamped: Vec::new(),
+        clamped: Clamped::new(),
     })
 }
 
@@ -422,19 +481,19 @@ fn qp_on_the_line<const D: usize>(
         return Distribution {
             feasible: inside(&minimum_norm, limits),
             tensions: minimum_norm,
-            clamped: Vec::new(),
+            clamped: Clamped::new(),
         };
     }
     let s = 0.0f64.clamp(lo.0, hi.0);
     let mut tensions = Tensions::from_fn(m, |i| minimum_norm[i] + s * null[i]);
-    let clamped: Vec<(CableId, Bound)> = match (s == lo.0, s == hi.0) {
+    let clamped: Clamped = match (s == lo.0, s == hi.0) {
         (true, _) => lo.1.into_iter().collect(),
         (_, true) => hi.1.into_iter().collect(),
-        _ => Vec::new(),
+        _ => Clamped::new(),
     };
     // The cable that sets s sits exactly on its bound (not an ulp past it, which a clamp
     // downstream would count as saturation).
-    for &(cable, bound) in &clamped {
+    for &(cable, bound) in clamped.iter() {
         tensions[cable.index()] = match bound {
             Bound::Min => limits.t_min,
             Bound::Max => limits.t_max,
@@ -548,7 +607,7 @@ fn qp_by_enumeration<const D: usize>(
     Distribution {
         tensions,
         feasible: false,
-        clamped: Vec::new(),
+        clamped: Clamped::new(),
     }
 }
 
