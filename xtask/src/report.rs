@@ -103,13 +103,7 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
         let figures = crate::sweep_study::write(&study, out)?;
         study_section.push_str(&study.section(&figures));
     }
-    // The printer's speed–accuracy frontier: 160 prints of two first layers (~30 s on two cores).
-    let printing = cdpr_studies::print_study::run(
-        &crate::print_study::printer_scenario()?,
-        &crate::print_study::parts()?,
-    )?;
-    crate::print_study::write(&printing, out)?;
-    study_section.push_str(&printing.section("print-frontier"));
+    study_section.push_str(&printing_section(out)?);
     write_json(
         &out.join("metrics.json"),
         &ReportFile {
@@ -161,6 +155,17 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The printer's speed–accuracy frontier (160 prints of two first layers, ~30 s on two cores):
+/// its files into `out`, its section of REPORT.md returned.
+fn printing_section(out: &Path) -> Result<String> {
+    let printing = cdpr_studies::print_study::run(
+        &crate::print_study::printer_scenario()?,
+        &crate::print_study::parts()?,
+    )?;
+    crate::print_study::write(&printing, out)?;
+    Ok(printing.section("print-frontier"))
 }
 
 fn curves(outcomes: &[Outcome]) -> Vec<Curve<'_>> {

@@ -66,73 +66,28 @@ impl Limits {
     /// Refuses a value outside Klipper's range, naming the `[printer]` key.
     pub fn validate(&self) -> Result<(), PlanError> {
         let e = &self.extruder;
+        let optional_positive = |v: Option<f64>| (v.unwrap_or(1.0), v.is_none_or(|v| v > 0.0));
+        let (cross, cross_ok) = optional_positive(e.max_extrude_cross_section);
+        let (e_velocity, e_velocity_ok) = optional_positive(e.max_extrude_only_velocity);
+        let (e_accel, e_accel_ok) = optional_positive(e.max_extrude_only_accel);
+        #[rustfmt::skip]
         let checks: [(&'static str, f64, bool, &str); 11] = [
-            (
-                "printer.max_velocity",
-                self.max_velocity,
-                self.max_velocity > 0.0,
-                "> 0 m/s",
-            ),
-            (
-                "printer.max_accel",
-                self.max_accel,
-                self.max_accel > 0.0,
-                "> 0 m/s²",
-            ),
-            (
-                "printer.square_corner_velocity",
-                self.square_corner_velocity,
-                self.square_corner_velocity >= 0.0,
-                "≥ 0 m/s",
-            ),
-            (
-                "printer.minimum_cruise_ratio",
-                self.minimum_cruise_ratio,
-                (0.0..1.0).contains(&self.minimum_cruise_ratio),
-                "0 ≤ ratio < 1",
-            ),
-            (
-                "printer.nozzle_diameter",
-                e.nozzle_diameter,
-                e.nozzle_diameter > 0.0,
-                "> 0 m",
-            ),
-            (
-                "printer.filament_diameter",
-                e.filament_diameter,
-                e.filament_diameter >= e.nozzle_diameter,
-                "≥ nozzle_diameter",
-            ),
-            (
-                "printer.max_extrude_cross_section",
-                e.max_extrude_cross_section.unwrap_or(1.0),
-                e.max_extrude_cross_section.is_none_or(|v| v > 0.0),
-                "> 0 m²",
-            ),
-            (
-                "printer.max_extrude_only_velocity",
-                e.max_extrude_only_velocity.unwrap_or(1.0),
-                e.max_extrude_only_velocity.is_none_or(|v| v > 0.0),
-                "> 0 m/s",
-            ),
-            (
-                "printer.max_extrude_only_accel",
-                e.max_extrude_only_accel.unwrap_or(1.0),
-                e.max_extrude_only_accel.is_none_or(|v| v > 0.0),
-                "> 0 m/s²",
-            ),
-            (
-                "printer.max_extrude_only_distance",
-                e.max_extrude_only_distance,
-                e.max_extrude_only_distance >= 0.0,
-                "≥ 0 m",
-            ),
-            (
-                "printer.instantaneous_corner_velocity",
-                e.instantaneous_corner_velocity,
-                e.instantaneous_corner_velocity >= 0.0,
-                "≥ 0 m/s",
-            ),
+            ("printer.max_velocity", self.max_velocity, self.max_velocity > 0.0, "> 0 m/s"),
+            ("printer.max_accel", self.max_accel, self.max_accel > 0.0, "> 0 m/s²"),
+            ("printer.square_corner_velocity", self.square_corner_velocity,
+                self.square_corner_velocity >= 0.0, "≥ 0 m/s"),
+            ("printer.minimum_cruise_ratio", self.minimum_cruise_ratio,
+                (0.0..1.0).contains(&self.minimum_cruise_ratio), "0 ≤ ratio < 1"),
+            ("printer.nozzle_diameter", e.nozzle_diameter, e.nozzle_diameter > 0.0, "> 0 m"),
+            ("printer.filament_diameter", e.filament_diameter,
+                e.filament_diameter >= e.nozzle_diameter, "≥ nozzle_diameter"),
+            ("printer.max_extrude_cross_section", cross, cross_ok, "> 0 m²"),
+            ("printer.max_extrude_only_velocity", e_velocity, e_velocity_ok, "> 0 m/s"),
+            ("printer.max_extrude_only_accel", e_accel, e_accel_ok, "> 0 m/s²"),
+            ("printer.max_extrude_only_distance", e.max_extrude_only_distance,
+                e.max_extrude_only_distance >= 0.0, "≥ 0 m"),
+            ("printer.instantaneous_corner_velocity", e.instantaneous_corner_velocity,
+                e.instantaneous_corner_velocity >= 0.0, "≥ 0 m/s"),
         ];
         for (key, value, ok, allowed) in checks {
             if !ok || !value.is_finite() {

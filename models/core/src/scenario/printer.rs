@@ -164,3 +164,48 @@ impl Printer {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::scenario::Scenario;
+
+    const SPATIAL: &str = "[robot]\nanchors = [[0.0, -1.6, -0.1], [1.3, 1.3, -0.1], \
+        [-1.4, 0.7, -0.1], [0.0, 0.0, 2.3]]\n[controller]\nkind = \"computed-torque\"\n\
+        t_min = 10.0\nt_max = 70.0\n[trajectory]\nstart = [0.0, 0.0, 0.0]\nend = [0.0, 0.0, 0.0]\n";
+
+    /// Every `[printer]` key out of its range is refused by name, with its value and range,
+    /// before any work; a valid section reads back in SI.
+    #[test]
+    fn printer_keys_are_checked_by_name() {
+        for (line, key) in [
+            ("max_accel = -1.0", "printer.max_accel"),
+            ("max_velocity = 0.0", "printer.max_velocity"),
+            ("minimum_cruise_ratio = 1.0", "printer.minimum_cruise_ratio"),
+            (
+                "square_corner_velocity = -0.001",
+                "printer.square_corner_velocity",
+            ),
+            ("filament_diameter = 0.0001", "printer.filament_diameter"),
+            (
+                "max_extrude_only_accel = 0.0",
+                "printer.max_extrude_only_accel",
+            ),
+            ("origin = [0.0, 0.0]", "printer.origin"),
+            ("shaper_freq_x = -20.0", "printer.shaper_freq_x"),
+            ("damping_ratio = 1.0", "printer.damping_ratio"),
+        ] {
+            let text = format!("{SPATIAL}[printer]\n{line}\n");
+            let err = Scenario::from_toml_str(&text).unwrap_err().to_string();
+            assert!(err.contains(key), "{line}: {err}");
+        }
+        let ok = Scenario::from_toml_str(&format!(
+            "{SPATIAL}[printer]\norigin = [-0.1, -0.1, 0.0]\nmax_accel = 5.0\nshaper = \"mzv\"\n\
+             shaper_freq_x = 0.0\nshaper_freq_y = 40.0\n"
+        ))
+        .unwrap();
+        let p = ok.printer.unwrap();
+        assert_eq!(p.origin3(), [-0.1, -0.1, 0.0]);
+        assert_eq!(p.limits().max_accel, 5.0);
+        assert_eq!(p.limits().max_velocity, 0.3, "Klipper-like default");
+    }
+}
