@@ -1,19 +1,22 @@
-//! Klipper's input shapers (`klippy/extras/shaper_defs.py`, Dmitry Butyugin's definitions),
-//! rewritten from their published formulas: pulses (A_i, T_i) for a shaper frequency f [Hz] and
-//! damping ratio ζ, with t_d = 1 / (f √(1 − ζ²)) the damped period.
+//! The input shapers of printer firmware: pulses (A_i, T_i) for a shaper frequency f [Hz] and
+//! damping ratio ζ, with t_d = 1 / (f √(1 − ζ²)) the damped period. Klipper offers these six
+//! (its documentation, "Resonance compensation"); the formulas and fitted numbers are the
+//! published ones cited below.
 //!
-//! - ZV, ZVD: (1, K) at (0, t_d/2); (1, 2K, K²) at (0, t_d/2, t_d), K = exp(−ζπ/√(1 − ζ²)).
-//! - MZV: three pulses over 3/4 t_d with zeros at f and 5f/3 (Klipper solves them by a
-//!   pseudo-inverse; the solution is the closed form (1 − 1/√2, √2 − 1, 1 − 1/√2) weighted by
-//!   K′ⁱ = exp(−3ζπ/(4√(1 − ζ²)))ⁱ at (0, 3/8, 3/4) t_d).
-//! - EI: Klipper's polynomial fit in ζ for a tolerated vibration of 1/20.
-//! - 2-hump and 3-hump EI: Klipper's cubic expansions in ζ of every pulse's time and amplitude.
+//! - ZV, ZVD (Singer & Seering 1990): (1, K) at (0, t_d/2); (1, 2K, K²) at (0, t_d/2, t_d),
+//!   K = exp(−ζπ/√(1 − ζ²)).
+//! - MZV: three pulses over 3/4 t_d with zero residual vibration at f and 5f/3, i.e.
+//!   (1 − 1/√2, √2 − 1, 1 − 1/√2) weighted by K′ⁱ = exp(−3ζπ/(4√(1 − ζ²)))ⁱ at (0, 3/8, 3/4) t_d.
+//! - EI, two- and three-hump EI (Singhose, Porter, Tuttle & Singhose 1997, "Vibration reduction
+//!   using multi-hump input shapers", J. Dyn. Sys. Meas. Control 119): the damped designs as
+//!   curve fits in ζ, EI's also in the tolerated vibration V (firmware uses V = 5 %), the
+//!   multi-hump ones at V = 5 %.
 //!
-//! How firmware applies them (`kin_shaper.c`): per axis, the position at t is
+//! How firmware applies them per axis (Klipper's kinematic shaper): the position at t is
 //! Σ A_i x(t − (T_i − T̄)) / Σ A, T̄ = Σ A_i T_i / Σ A — the convolution advanced by the
-//! pulses' centroid, so shaping delays no axis on average.
+//! pulses' centroid, so shaping delays no axis on average ([`centred`]).
 
-/// Klipper's shaper names.
+/// The firmware's shapers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Shaper {
     /// Zero vibration.
@@ -30,11 +33,19 @@ pub enum Shaper {
     ThreeHumpEi,
 }
 
-/// Klipper's vibration tolerance of the EI fit (1 / SHAPER_VIBRATION_REDUCTION).
-const EI_VTOL: f64 = 1.0 / 20.0;
+/// The vibration the EI family tolerates at its design frequency (5 %).
+const EI_VTOL: f64 = 0.05;
 
-/// Pulses (amplitudes as Klipper gives them, not normalised; times [s] from 0) of `shaper` at
-/// `freq` [Hz] and damping ratio `damping`.
+/// c₀ + c₁ ζ + c₂ ζ² + … by Horner's rule.
+fn polynomial(coefficients: &[f64], zeta: f64) -> f64 {
+    coefficients
+        .iter()
+        .rev()
+        .fold(0.0, |acc, &c| acc * zeta + c)
+}
+
+/// Pulses (amplitudes as designed, not normalised; times [s] from 0) of `shaper` at `freq` [Hz]
+/// and damping ratio `damping`.
 ///
 /// # Examples
 /// ```
@@ -58,62 +69,76 @@ pub fn pulses(shaper: Shaper, freq: f64, damping: f64) -> (Vec<f64>, Vec<f64>) {
                 vec![0.0, 0.375 * t_d, 0.75 * t_d],
             )
         }
-        Shaper::Ei => {
-            let (v, dr) = (EI_VTOL, damping);
-            let a1 = (0.24968 + 0.24961 * v)
-                + ((0.80008 + 1.23328 * v) + (0.49599 + 3.17316 * v) * dr) * dr;
-            let a3 = (0.25149 + 0.21474 * v)
-                + ((-0.83249 + 1.41498 * v) + (0.85181 - 4.90094 * v) * dr) * dr;
-            let t2 = 0.4999
-                + (((0.46159 + 8.57843 * v) * v)
-                    + (((4.26169 - 108.644 * v) * v) + ((1.75601 + 336.989 * v) * v) * dr) * dr)
-                    * dr;
-            (vec![a1, 1.0 - a1 - a3, a3], vec![0.0, t2 * t_d, t_d])
-        }
-        Shaper::TwoHumpEi => expansion(freq, damping, &TWO_HUMP_T, &TWO_HUMP_A),
-        Shaper::ThreeHumpEi => expansion(freq, damping, &THREE_HUMP_T, &THREE_HUMP_A),
+        Shaper::Ei => ei(damping, t_d),
+        Shaper::TwoHumpEi => fitted(&TWO_HUMP_EI, freq, damping),
+        Shaper::ThreeHumpEi => fitted(&THREE_HUMP_EI, freq, damping),
     }
 }
 
-/// Pulses from cubic expansions in ζ: T_i = (Σ_j t_ij ζʲ) / f, A_i = Σ_j a_ij ζʲ (Horner).
-fn expansion<const N: usize>(
-    freq: f64,
-    damping: f64,
-    t: &[[f64; 4]; N],
-    a: &[[f64; 4]; N],
-) -> (Vec<f64>, Vec<f64>) {
-    let horner = |c: &[f64; 4]| c.iter().rev().fold(0.0, |acc, &ci| acc * damping + ci);
+/// EI's three pulses: the outer amplitudes and the middle pulse's time as quadratics
+/// (amplitudes) and a cubic (time, in units of t_d) in ζ, each coefficient linear in V.
+fn ei(zeta: f64, t_d: f64) -> (Vec<f64>, Vec<f64>) {
+    let v = EI_VTOL;
+    let first = [
+        0.24968 + 0.24961 * v,
+        0.80008 + 1.23328 * v,
+        0.49599 + 3.17316 * v,
+    ];
+    let last = [
+        0.25149 + 0.21474 * v,
+        -0.83249 + 1.41498 * v,
+        0.85181 - 4.90094 * v,
+    ];
+    let middle_time = [
+        0.4999,
+        (0.46159 + 8.57843 * v) * v,
+        (4.26169 - 108.644 * v) * v,
+        (1.75601 + 336.989 * v) * v,
+    ];
+    let (a1, a3) = (polynomial(&first, zeta), polynomial(&last, zeta));
     (
-        a.iter().map(horner).collect(),
-        t.iter().map(|c| horner(c) / freq).collect(),
+        vec![a1, 1.0 - a1 - a3, a3],
+        vec![0.0, polynomial(&middle_time, zeta) * t_d, t_d],
     )
 }
 
-const TWO_HUMP_T: [[f64; 4]; 4] = [
-    [0.0, 0.0, 0.0, 0.0],
-    [0.49890, 0.16270, -0.54262, 6.16180],
-    [0.99748, 0.18382, -1.58270, 8.17120],
-    [1.49920, -0.09297, -0.28338, 1.85710],
+/// One pulse of a fitted design: its time (in periods 1/f) and amplitude as cubics in ζ
+/// (coefficients of 1, ζ, ζ², ζ³).
+struct FittedPulse {
+    periods: [f64; 4],
+    amplitude: [f64; 4],
+}
+
+/// A fitted design's pulses at `freq` [Hz] and damping ratio `zeta`.
+fn fitted(design: &[FittedPulse], freq: f64, zeta: f64) -> (Vec<f64>, Vec<f64>) {
+    design
+        .iter()
+        .map(|p| {
+            (
+                polynomial(&p.amplitude, zeta),
+                polynomial(&p.periods, zeta) / freq,
+            )
+        })
+        .unzip()
+}
+
+/// Two-hump EI at V = 5 % (Singhose et al. 1997).
+#[rustfmt::skip]
+const TWO_HUMP_EI: [FittedPulse; 4] = [
+    FittedPulse { periods: [0.0, 0.0, 0.0, 0.0], amplitude: [0.16054, 0.76699, 2.26560, -1.22750] },
+    FittedPulse { periods: [0.49890, 0.16270, -0.54262, 6.16180], amplitude: [0.33911, 0.45081, -2.58080, 1.73650] },
+    FittedPulse { periods: [0.99748, 0.18382, -1.58270, 8.17120], amplitude: [0.34089, -0.61533, -0.68765, 0.42261] },
+    FittedPulse { periods: [1.49920, -0.09297, -0.28338, 1.85710], amplitude: [0.15997, -0.60246, 1.00280, -0.93145] },
 ];
-const TWO_HUMP_A: [[f64; 4]; 4] = [
-    [0.16054, 0.76699, 2.26560, -1.22750],
-    [0.33911, 0.45081, -2.58080, 1.73650],
-    [0.34089, -0.61533, -0.68765, 0.42261],
-    [0.15997, -0.60246, 1.00280, -0.93145],
-];
-const THREE_HUMP_T: [[f64; 4]; 5] = [
-    [0.0, 0.0, 0.0, 0.0],
-    [0.49974, 0.23834, 0.44559, 12.4720],
-    [0.99849, 0.29808, -2.36460, 23.3990],
-    [1.49870, 0.10306, -2.01390, 17.0320],
-    [1.99960, -0.28231, 0.61536, 5.40450],
-];
-const THREE_HUMP_A: [[f64; 4]; 5] = [
-    [0.11275, 0.76632, 3.29160, -1.44380],
-    [0.23698, 0.61164, -2.57850, 4.85220],
-    [0.30008, -0.19062, -2.14560, 0.13744],
-    [0.23775, -0.73297, 0.46885, -2.08650],
-    [0.11244, -0.45439, 0.96382, -1.46000],
+
+/// Three-hump EI at V = 5 % (Singhose et al. 1997).
+#[rustfmt::skip]
+const THREE_HUMP_EI: [FittedPulse; 5] = [
+    FittedPulse { periods: [0.0, 0.0, 0.0, 0.0], amplitude: [0.11275, 0.76632, 3.29160, -1.44380] },
+    FittedPulse { periods: [0.49974, 0.23834, 0.44559, 12.4720], amplitude: [0.23698, 0.61164, -2.57850, 4.85220] },
+    FittedPulse { periods: [0.99849, 0.29808, -2.36460, 23.3990], amplitude: [0.30008, -0.19062, -2.14560, 0.13744] },
+    FittedPulse { periods: [1.49870, 0.10306, -2.01390, 17.0320], amplitude: [0.23775, -0.73297, 0.46885, -2.08650] },
+    FittedPulse { periods: [1.99960, -0.28231, 0.61536, 5.40450], amplitude: [0.11244, -0.45439, 0.96382, -1.46000] },
 ];
 
 /// The pulses as firmware applies them to an axis: amplitudes normalised to sum 1, times

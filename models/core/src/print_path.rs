@@ -1,7 +1,7 @@
 //! A printed path as a robot's reference: the firmware's plan ([`cdpr_printing::planner`])
 //! placed in the robot's frame (`[printer] origin` + the file's coordinates), each Cartesian
 //! axis convolved with its own input shaper as the firmware's step generation does
-//! (`kin_shaper.c`: Σ A_i x(t − τ_i), the pulses' times τ_i taken from their centroid). A
+//! (Σ A_i x(t − τ_i), the pulses' times τ_i taken from their centroid). A
 //! planar robot prints the file's X and Z.
 //!
 //! The loop's clock starts `lead` before the plan's t = 0: [`PRE_ROLL`] plus the largest
