@@ -53,8 +53,8 @@ pub use config::{
 };
 pub use kind::ModelKind;
 pub use print::{
-    FEASIBILITY_RATE, PreparedPrint, PrintRun, SETTLE, contour_of, gcode_home, positions,
-    prepare_print, print_options, simulate_print,
+    FEASIBILITY_RATE, PreparedPrint, PrintRun, SETTLE, contour_of, gcode_home, plan_layers,
+    positions, prepare_print, print_options, simulate_print,
 };
 pub use provenance::{Provenance, project_revision, revision};
 pub use spatial::{

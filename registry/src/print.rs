@@ -10,11 +10,11 @@ use cdpr_core::closed_loop::Path;
 use cdpr_core::print_path::{AxisShaper, PrintPath};
 use cdpr_core::robot::Vector;
 use cdpr_core::runner::{Observer, Run, RunOptions, simulate_observed_reusing};
-use cdpr_core::scenario::{Designed, FirmwareShaper, Printer, Scenario, out_of_range};
+use cdpr_core::scenario::{Designed, Printer, Scenario, out_of_range};
 use cdpr_core::series::SeriesBuffer;
 use cdpr_printing::gcode::{self, Program};
 use cdpr_printing::planner::{self, Plan};
-use cdpr_printing::shaper::{Shaper, pulses};
+use cdpr_printing::shaper::pulses;
 use std::ops::RangeInclusive;
 use std::sync::Arc;
 
@@ -31,8 +31,6 @@ pub const FEASIBILITY_RATE: f64 = 1000.0;
 pub struct PreparedPrint {
     /// The file as read (skipped commands listed).
     pub program: Program,
-    /// The whole file's plan.
-    pub plan: Plan,
     /// The layers printed.
     pub layers: RangeInclusive<usize>,
     /// The reference: the layers' part of the plan, in the robot's frame, shaped.
@@ -54,7 +52,31 @@ pub fn prepare_print(
 ) -> Result<PreparedPrint, Error> {
     let robot = spatial_robot(scenario)?;
     let printer = scenario.printer.clone().unwrap_or_default();
-    let origin = printer.origin3();
+    let (program, layers, selected) = plan_layers(scenario, gcode_text, layers)?;
+    let shapers = axis_shapers(&printer)?;
+    let path = PrintPath::new(Arc::new(selected), printer.origin3(), shapers)
+        .expect("a selection has segments");
+    let rate = FEASIBILITY_RATE;
+    let n = (path.duration() * rate).ceil() as usize;
+    check_feasible(scenario, &robot, (0..=n).map(|k| k as f64 / rate), |t| {
+        let [p, _, a] = path.reference(t, true);
+        (p, a)
+    })?;
+    Ok(PreparedPrint {
+        program,
+        layers,
+        path: Arc::new(path),
+    })
+}
+
+/// The file read and planned under the scenario's `[printer]`, and the plan's part that prints
+/// `layers` (all: `None`) — refused when those layers do not move.
+pub fn plan_layers(
+    scenario: &Scenario,
+    gcode_text: &str,
+    layers: Option<RangeInclusive<usize>>,
+) -> Result<(Program, RangeInclusive<usize>, Plan), Error> {
+    let printer = scenario.printer.clone().unwrap_or_default();
     let program = gcode::read(gcode_text, gcode_home(scenario))?;
     let plan = planner::plan(&program, &printer.limits())?;
     let layers = layers.unwrap_or(0..=program.layers);
@@ -65,21 +87,7 @@ pub fn prepare_print(
             format!("layers with moves among 0..{}", program.layers),
         )
     })?;
-    let shapers = axis_shapers(&printer)?;
-    let path =
-        PrintPath::new(Arc::new(selected), origin, shapers).expect("a selection has segments");
-    let rate = FEASIBILITY_RATE;
-    let n = (path.duration() * rate).ceil() as usize;
-    check_feasible(scenario, &robot, (0..=n).map(|k| k as f64 / rate), |t| {
-        let [p, _, a] = path.reference(t, true);
-        (p, a)
-    })?;
-    Ok(PreparedPrint {
-        program,
-        plan,
-        layers,
-        path: Arc::new(path),
-    })
+    Ok((program, layers, selected))
 }
 
 /// Where G28 brings the effector, the robot's start pose (`[trajectory] start`, else the
@@ -110,14 +118,8 @@ pub fn positions(run: &Run) -> impl Iterator<Item = (f64, Vector<3>)> + '_ {
 
 /// The firmware's shaper of each axis (None when `[printer] shaper = "none"`).
 fn axis_shapers(printer: &Printer) -> Result<[Option<AxisShaper>; 3], Error> {
-    let shaper = match printer.shaper {
-        FirmwareShaper::None => return Ok([None, None, None]),
-        FirmwareShaper::Zv => Shaper::Zv,
-        FirmwareShaper::Mzv => Shaper::Mzv,
-        FirmwareShaper::Zvd => Shaper::Zvd,
-        FirmwareShaper::Ei => Shaper::Ei,
-        FirmwareShaper::TwoHumpEi => Shaper::TwoHumpEi,
-        FirmwareShaper::ThreeHumpEi => Shaper::ThreeHumpEi,
+    let Some(shaper) = printer.shaper.pulses_of() else {
+        return Ok([None, None, None]);
     };
     let axis = |key: &'static str, f: Designed| -> Result<Option<AxisShaper>, Error> {
         match f {

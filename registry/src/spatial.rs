@@ -134,14 +134,14 @@ pub fn check_feasible(
         t_max: scenario.controller.t_max.unwrap_or(f64::INFINITY),
     };
     let mass = robot.effector_mass;
+    let lift = along_vertical::<3>(robot.gravity);
     for t in times {
         let (p, a) = reference(t);
-        let lift = along_vertical::<3>(robot.gravity);
+        let w = robot.structure_matrix(&p);
         for (load, wrench) in [
             ("at rest", lift * mass),
             ("with its acceleration", (a + lift) * mass),
         ] {
-            let w = robot.structure_matrix(&p);
             let d = distribute(DistributionMethod::Qp, &w, &wrench, limits).map_err(|e| {
                 out_of_range(
                     "trajectory",

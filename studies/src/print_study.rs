@@ -169,21 +169,18 @@ pub fn resolve_auto(scenario: &Scenario, centre: [f64; 3]) -> Result<Scenario> {
 
 /// The centre of the bounding box of `part`'s printed layers in the robot's frame [m].
 pub fn layer_centre(scenario: &Scenario, part: &Part) -> Result<[f64; 3]> {
-    let mut plain = scenario.clone();
-    if let Some(p) = plain.printer.as_mut() {
-        p.shaper = FirmwareShaper::None;
-    }
-    let print = cdpr_bench::prepare_print(&plain, &part.gcode, Some(part.layers.clone()))?;
-    let path = &print.path;
+    let (_, layers, plan) =
+        cdpr_bench::plan_layers(scenario, &part.gcode, Some(part.layers.clone()))?;
+    let origin = scenario.printer.clone().unwrap_or_default().origin3();
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for i in 0..path.plan().segments.len() {
-        if !part.layers.contains(&path.plan().segments[i].layer) {
-            continue;
-        }
-        let (a, b) = path.segment_ends(i);
+    for g in plan.segments.iter().filter(|g| layers.contains(&g.layer)) {
+        let length = g.length();
         for k in 0..3 {
-            lo[k] = lo[k].min(a[k]).min(b[k]);
-            hi[k] = hi[k].max(a[k]).max(b[k]);
+            // In the robot's frame, as `PrintPath::segment_ends` places them.
+            let a = origin[k] + g.start[k] + g.dir[k] * 0.0;
+            let b = origin[k] + g.start[k] + g.dir[k] * length;
+            lo[k] = lo[k].min(a).min(b);
+            hi[k] = hi[k].max(a).max(b);
         }
     }
     Ok([0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k])))
@@ -248,7 +245,7 @@ pub fn run(base: &Scenario, parts: &[Part]) -> Result<PrintStudy> {
             part: job.part.name.clone(),
             setup: job.setup.label,
             accel_mm_s2: job.accel,
-            shaper: shaper_name(job.shaper).to_string(),
+            shaper: job.shaper.name().to_string(),
             shaper_freq_hz: if job.shaper == FirmwareShaper::None {
                 [f64::NAN; 2]
             } else {
@@ -287,19 +284,6 @@ fn configure(base: &Scenario, setup: Setup, accel: f64, shaper: FirmwareShaper) 
     // The first layer moves in z only at its start: z stays unshaped.
     printer.shaper_freq_z = Designed::Value(0.0);
     s
-}
-
-/// Klipper's name of a shaper.
-pub fn shaper_name(shaper: FirmwareShaper) -> &'static str {
-    match shaper {
-        FirmwareShaper::None => "none",
-        FirmwareShaper::Zv => "zv",
-        FirmwareShaper::Mzv => "mzv",
-        FirmwareShaper::Zvd => "zvd",
-        FirmwareShaper::Ei => "ei",
-        FirmwareShaper::TwoHumpEi => "2hump_ei",
-        FirmwareShaper::ThreeHumpEi => "3hump_ei",
-    }
 }
 
 impl PrintStudy {

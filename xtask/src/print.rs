@@ -65,12 +65,7 @@ pub fn plan(scenario: Option<&Path>, gcode_file: &Path, out: &Path) -> Result<()
     writable_out(out)?;
     let csv = plan.csv(origin);
     write_atomic(&out.join(PLAN), |w| w.write_all(csv.as_bytes()))?;
-    for s in &program.skipped {
-        eprintln!(
-            "skipped {} ({}×, first on line {})",
-            s.command, s.count, s.first_line
-        );
-    }
+    list_skipped(&program);
     println!(
         "{} segments over {} layers, print time {:.3} s, planned in {:.1} ms → {}",
         plan.segments.len(),
@@ -217,6 +212,7 @@ pub struct PrintOptions<'a> {
 /// `cargo xtask print`.
 pub fn print(options: &PrintOptions) -> Result<()> {
     let (scenario, prepared) = prepare(options)?;
+    list_skipped(&prepared.program);
     let provenance = Provenance::of(&scenario)?;
     let out = options.out;
     writable_out(out)?;
@@ -226,13 +222,9 @@ pub fn print(options: &PrintOptions) -> Result<()> {
     }
     let ended = run_streamed(&scenario, &prepared, out, options.every)?;
     let plan = prepared.path.plan();
-    let contour = ended
-        .run
-        .as_ref()
-        .map(|r| cdpr_bench::contour_of(&prepared, r));
-    write_metrics(options, &provenance, &prepared, &ended, contour.as_ref())?;
+    write_metrics(options, &provenance, &prepared, &ended)?;
     ended.written?;
-    if let (Some(run), Some(contour)) = (&ended.run, &contour) {
+    if let (Some(run), Some(contour)) = (&ended.run, &ended.contour) {
         crate::print_figures::write(&prepared, run, out)?;
         println!(
             "{} segments, print time {:.2} s, simulated in {:.2} s: contour error of the \
@@ -281,6 +273,16 @@ fn prepare(options: &PrintOptions) -> Result<(Scenario, PreparedPrint)> {
     Ok((scenario, prepared))
 }
 
+/// The commands the reader skipped, once each, on stderr.
+fn list_skipped(program: &gcode::Program) {
+    for s in &program.skipped {
+        eprintln!(
+            "skipped {} ({}×, first on line {})",
+            s.command, s.count, s.first_line
+        );
+    }
+}
+
 /// Where the print's channels sit in the run's row.
 fn columns(scenario: &Scenario) -> Result<(Columns, usize)> {
     let robot = cdpr_bench::spatial_robot(scenario)?;
@@ -301,6 +303,8 @@ fn columns(scenario: &Scenario) -> Result<(Columns, usize)> {
 /// "complete" | "interrupted" | "failed", why, its wall time, and whether print.csv was written.
 struct Ended {
     run: Option<cdpr_bench::core::runner::Run>,
+    /// The run's contour metrics (a complete run's from the print itself).
+    contour: Option<ContourMetrics>,
     status: &'static str,
     error: Option<String>,
     wall_s: f64,
@@ -333,16 +337,21 @@ fn run_streamed(
     };
     progress.finish();
     let wall_s = started.elapsed().as_secs_f64();
-    let (run, status, error) = match result {
-        Ok(done) => (Some(done.run), "complete", None),
+    let (run, contour, status, error) = match result {
+        Ok(done) => (Some(done.run), Some(done.contour), "complete", None),
         Err(Error::Run(failure)) => {
             let status = match failure.error {
                 RunError::Interrupted { .. } => "interrupted",
                 _ => "failed",
             };
-            (failure.partial, status, Some(failure.error.to_string()))
+            let contour = failure
+                .partial
+                .as_ref()
+                .map(|r| cdpr_bench::contour_of(prepared, r));
+            let error = Some(failure.error.to_string());
+            (failure.partial, contour, status, error)
         }
-        Err(e) => (None, "failed", Some(e.to_string())),
+        Err(e) => (None, None, "failed", Some(e.to_string())),
     };
     // A failed write fails the print whatever it did.
     let write_error = csv
@@ -364,6 +373,7 @@ fn run_streamed(
     }
     Ok(Ended {
         run,
+        contour,
         status,
         error: write_error.or(error),
         wall_s,
@@ -377,7 +387,6 @@ fn write_metrics(
     provenance: &Provenance,
     prepared: &PreparedPrint,
     ended: &Ended,
-    contour: Option<&ContourMetrics>,
 ) -> Result<()> {
     let plan = prepared.path.plan();
     let run = ended.run.as_ref();
@@ -392,7 +401,7 @@ fn write_metrics(
             segments: plan.segments.len(),
             print_time_s: plan.print_time,
             t_reached: run.map_or(0.0, |r| r.t_reached),
-            contour: contour.map(flat).unwrap_or_default(),
+            contour: ended.contour.as_ref().map(flat).unwrap_or_default(),
             samples: run.map_or(0, |r| r.series.len()),
             steps: run.map_or(0, |r| r.stats.steps_accepted),
             rhs_evaluations: run.map_or(0, |r| r.stats.rhs_evals),

@@ -10,7 +10,7 @@
 //! first instant.
 
 use crate::robot::Vector;
-use cdpr_printing::planner::Plan;
+use cdpr_printing::planner::{Plan, Reference};
 use std::sync::Arc;
 
 /// Rest before the plan's first move [s].
@@ -146,31 +146,41 @@ impl<const D: usize> PrintPath<D> {
     /// p_ref, ṗ_ref, p̈_ref at the loop's time `t` [s] (ṗ, p̈ zero unless `derivatives`).
     pub fn reference(&self, t: f64, derivatives: bool) -> [Vector<D>; 3] {
         let s = t - self.lead;
+        // The plan convolved with each distinct shaper once: axes sharing a shaper (or none)
+        // share the evaluation.
+        let mut evaluated: [Option<Reference>; D] = [None; D];
         let mut out = [Vector::<D>::zeros(); 3];
-        let mut unshaped = None;
         for (k, &axis) in Self::AXES.iter().enumerate() {
-            let mut value = [0.0; 3];
-            match &self.shapers[axis] {
-                Some(shaper) => {
-                    for (a, tau) in shaper.amplitudes.iter().zip(&shaper.offsets) {
-                        let (p, v, acc) = self.plan.reference(s - tau).expect("segments");
-                        value[0] += a * p[axis];
-                        value[1] += a * v[axis];
-                        value[2] += a * acc[axis];
-                    }
-                }
-                None => {
-                    let (p, v, acc) =
-                        *unshaped.get_or_insert_with(|| self.plan.reference(s).expect("segments"));
-                    value = [p[axis], v[axis], acc[axis]];
-                }
-            }
-            out[0][k] = self.origin[axis] + value[0];
+            let shaper = &self.shapers[axis];
+            let twin = (0..k).find(|&j| self.shapers[Self::AXES[j]] == *shaper);
+            let (p, v, a) = match twin.and_then(|j| evaluated[j]) {
+                Some(done) => done,
+                None => self.convolved(shaper.as_ref(), s),
+            };
+            evaluated[k] = Some((p, v, a));
+            out[0][k] = self.origin[axis] + p[axis];
             if derivatives {
-                out[1][k] = value[1];
-                out[2][k] = value[2];
+                out[1][k] = v[axis];
+                out[2][k] = a[axis];
             }
         }
         out
+    }
+
+    /// Σ A_i (p, v, a)(s − τ_i) of the plan at its time `s` [s] (unshaped: the plan's own).
+    fn convolved(&self, shaper: Option<&AxisShaper>, s: f64) -> Reference {
+        let Some(shaper) = shaper else {
+            return self.plan.reference(s).expect("a plan with segments");
+        };
+        let mut sum = ([0.0; 3], [0.0; 3], [0.0; 3]);
+        for (a, tau) in shaper.amplitudes.iter().zip(&shaper.offsets) {
+            let (p, v, acc) = self.plan.reference(s - tau).expect("a plan with segments");
+            for k in 0..3 {
+                sum.0[k] += a * p[k];
+                sum.1[k] += a * v[k];
+                sum.2[k] += a * acc[k];
+            }
+        }
+        sum
     }
 }

@@ -25,7 +25,7 @@ mod moves;
 mod plan;
 
 pub use limits::{ExtruderLimits, Limits, PlanError};
-pub use plan::{Plan, Segment};
+pub use plan::{Plan, Reference, Segment};
 
 use crate::gcode::{Instruction, LimitChange, Program};
 use lookahead::{FLUSH_TIME_AFTER_STOP, Lookahead};

@@ -4,6 +4,7 @@
 
 use super::{Designed, ScenarioError, finite, non_negative, out_of_range};
 use cdpr_printing::planner::{ExtruderLimits, Limits};
+use cdpr_printing::shaper::Shaper;
 use serde::Deserialize;
 
 /// The input shaper a firmware applies per Cartesian axis (Klipper's names and definitions).
@@ -20,6 +21,34 @@ pub enum FirmwareShaper {
     TwoHumpEi,
     #[serde(rename = "3hump_ei")]
     ThreeHumpEi,
+}
+
+impl FirmwareShaper {
+    /// The scenario file's (and Klipper's) spelling.
+    pub fn name(self) -> &'static str {
+        match self {
+            FirmwareShaper::None => "none",
+            FirmwareShaper::Zv => "zv",
+            FirmwareShaper::Mzv => "mzv",
+            FirmwareShaper::Zvd => "zvd",
+            FirmwareShaper::Ei => "ei",
+            FirmwareShaper::TwoHumpEi => "2hump_ei",
+            FirmwareShaper::ThreeHumpEi => "3hump_ei",
+        }
+    }
+
+    /// The design whose pulses it applies (None: unshaped).
+    pub fn pulses_of(self) -> Option<Shaper> {
+        match self {
+            FirmwareShaper::None => None,
+            FirmwareShaper::Zv => Some(Shaper::Zv),
+            FirmwareShaper::Mzv => Some(Shaper::Mzv),
+            FirmwareShaper::Zvd => Some(Shaper::Zvd),
+            FirmwareShaper::Ei => Some(Shaper::Ei),
+            FirmwareShaper::TwoHumpEi => Some(Shaper::TwoHumpEi),
+            FirmwareShaper::ThreeHumpEi => Some(Shaper::ThreeHumpEi),
+        }
+    }
 }
 
 /// `[printer]`; every key optional.
@@ -207,5 +236,15 @@ mod tests {
         assert_eq!(p.origin3(), [-0.1, -0.1, 0.0]);
         assert_eq!(p.limits().max_accel, 5.0);
         assert_eq!(p.limits().max_velocity, 0.3, "Klipper-like default");
+        // The names are the file's words (serde's spelling).
+        for shaper in [super::FirmwareShaper::Mzv, super::FirmwareShaper::TwoHumpEi] {
+            let text = format!("{SPATIAL}[printer]\nshaper = \"{}\"\n", shaper.name());
+            let read = Scenario::from_toml_str(&text)
+                .unwrap()
+                .printer
+                .unwrap()
+                .shaper;
+            assert_eq!(read, shaper);
+        }
     }
 }
