@@ -16,13 +16,14 @@ use crate::AnalysisError;
 use crate::modes::{Analysis, ClassifiedMode, Loop, classify};
 use cdpr_core::closed_loop::{Actuation, ClosedLoop};
 use cdpr_core::controller::Controller;
+use cdpr_core::modal_layout::ModalLayout;
 use cdpr_core::model::{CableModel, Equilibrium};
 use cdpr_core::robot::height;
 use cdpr_core::scenario::Scenario;
 use cdpr_core::shaper::Impulses;
 use cdpr_core::trajectory::Step5;
 use cdpr_numerics::differences::{jacobian, jacobian_within};
-use cdpr_numerics::eigen::{Mode, mode_shapes, modes, nearest_mode, reduce};
+use cdpr_numerics::eigen::{Mode, ModeShape, mode_shapes, modes, nearest_mode, reduce};
 use faer::Mat;
 
 /// Jacobian ∂y'/∂y of the closed loop (model and PID states; the audit states are left out) at
@@ -98,14 +99,39 @@ pub fn linearise<M: CableModel<D>, const D: usize>(
     scale[np..n].fill(1.0);
     let jac = jacobian_within(&mut sys, 0.0, &y, m, &reach, &scale);
     let shapes = mode_shapes(&reduce(&jac, &keep))?;
+    let (modes, vectors) = classified(&shapes, &keep, (m, np), &layout);
+    let p = sys.model.effector(&eq.state).position;
+    Ok(Linearised {
+        analysis: Analysis {
+            model: sys.model.name(),
+            x: p[0],
+            z: height(&p),
+            feedback,
+            tensions,
+            modes,
+        },
+        state: y,
+        vectors,
+    })
+}
+
+/// Each mode shape of the reduced loop mapped back to its `m` states (zeros on the dropped
+/// coordinates), classified by its `np` positions on the model's layout and numbered within its
+/// kind.
+fn classified(
+    shapes: &[ModeShape],
+    keep: &[usize],
+    (m, np): (usize, usize),
+    layout: &ModalLayout,
+) -> (Vec<ClassifiedMode>, Vec<Vec<(f64, f64)>>) {
     let mut modes = Vec::with_capacity(shapes.len());
     let mut vectors = Vec::with_capacity(shapes.len());
-    for shape in &shapes {
+    for shape in shapes {
         let mut full = vec![(0.0, 0.0); m];
         for (k, &i) in keep.iter().enumerate() {
             full[i] = shape.vector[k];
         }
-        let (kind, purity) = classify(&layout, &full[..np]);
+        let (kind, purity) = classify(layout, &full[..np]);
         modes.push(ClassifiedMode {
             mode: shape.mode,
             kind,
@@ -120,19 +146,7 @@ pub fn linearise<M: CableModel<D>, const D: usize>(
         *c += 1;
         m.order = *c;
     }
-    let p = sys.model.effector(&eq.state).position;
-    Ok(Linearised {
-        analysis: Analysis {
-            model: sys.model.name(),
-            x: p[0],
-            z: height(&p),
-            feedback,
-            tensions,
-            modes,
-        },
-        state: y,
-        vectors,
-    })
+    (modes, vectors)
 }
 
 /// Largest linearised loop (model states + the two controller states) whose modes are computed:

@@ -111,25 +111,9 @@ pub struct Metrics {
     /// Mean and peak-to-peak of z over the `settled` window [m].
     pub z_mean: f64,
     pub z_p2p: f64,
-    /// Refined spectral peaks (Hann, 16× padding, ω ≥ 2 rad/s) of z and of the error over the
-    /// `settled` window, at least [`MIN_SPECTRAL_WINDOW`] long [rad/s].
-    pub z_peak_rad_s: f64,
-    pub err_peak_rad_s: f64,
-    /// Plain FFT peaks (rectangular window, no padding) over the `settled` window [rad/s].
-    pub z_plain_peak_rad_s: f64,
-    pub err_plain_peak_rad_s: f64,
-    /// Plain FFT peak of z over the whole `record`, at least [`MIN_SPECTRAL_WINDOW`] long
-    /// [rad/s], and its bin index (the paper's 20.11 rad/s is bin 16 of its 5 s record).
-    pub z_fft_record_rad_s: f64,
-    pub z_fft_record_bin: usize,
-    /// Largest local maximum of the refined error spectrum above 100 rad/s over the `settled`
-    /// window [rad/s] and its level
-    /// relative to the main error peak [dB].
-    pub err_hf_peak_rad_s: f64,
-    pub err_hf_peak_db: f64,
-    /// The [`HF_PEAKS`] largest local maxima of the refined error spectrum above 100 rad/s,
-    /// as [ω rad/s, dB relative to the main error peak], largest first.
-    pub err_hf_peaks: Vec<[f64; 2]>,
+    /// The spectral peaks of z and of the error.
+    #[serde(flatten)]
+    pub spectral: SpectralPeaks,
     /// Effector z and PID force at the initial equilibrium [m, N].
     pub z0: f64,
     pub f0: f64,
@@ -156,6 +140,30 @@ pub struct Metrics {
     /// The vibration-control metrics.
     #[serde(flatten)]
     pub control: ControlMetrics,
+}
+
+/// The spectral peaks of a run (MODELS.md §7), keys of `metrics.json` as in [`Metrics`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SpectralPeaks {
+    /// Refined spectral peaks (Hann, 16× padding, ω ≥ 2 rad/s) of z and of the error over the
+    /// `settled` window, at least [`MIN_SPECTRAL_WINDOW`] long [rad/s].
+    pub z_peak_rad_s: f64,
+    pub err_peak_rad_s: f64,
+    /// Plain FFT peaks (rectangular window, no padding) over the `settled` window [rad/s].
+    pub z_plain_peak_rad_s: f64,
+    pub err_plain_peak_rad_s: f64,
+    /// Plain FFT peak of z over the whole `record`, at least [`MIN_SPECTRAL_WINDOW`] long
+    /// [rad/s], and its bin index (the paper's 20.11 rad/s is bin 16 of its 5 s record).
+    pub z_fft_record_rad_s: f64,
+    pub z_fft_record_bin: usize,
+    /// Largest local maximum of the refined error spectrum above 100 rad/s over the `settled`
+    /// window [rad/s] and its level
+    /// relative to the main error peak [dB].
+    pub err_hf_peak_rad_s: f64,
+    pub err_hf_peak_db: f64,
+    /// The [`HF_PEAKS`] largest local maxima of the refined error spectrum above 100 rad/s,
+    /// as [ω rad/s, dB relative to the main error peak], largest first.
+    pub err_hf_peaks: Vec<[f64; 2]>,
     /// Why each null spectral peak is none (read into `unavailable`).
     #[serde(skip)]
     no_peak: Vec<(&'static str, NoPeak)>,
@@ -424,42 +432,21 @@ fn chatter(events: &[cdpr_core::model::ModelEvent]) -> usize {
     count
 }
 
-impl Metrics {
-    /// Computes every metric of `run` sampled every `dt` [s] on the trajectory `step5`, with
-    /// the controller's `context` (whose move end is the shaped reference's where one is shaped).
-    pub fn from_run(run: &Run, step5: &Step5, dt: f64, context: &ControlContext) -> Self {
-        let c = Columns::of(run);
-        let (t, x, z, err) = (c.t, c.x, c.z, c.err);
-        let cable = |i: usize| c.tensions.get(i).copied().unwrap_or_default();
-        let (t1, t2) = (cable(0), cable(1));
-        let t_end = t.last().copied().unwrap_or(0.0);
-        let windows = Windows::new(context.move_start, context.move_end, t_end);
+/// max over the run of (x − x2)·sign(x2 − x1) [m] (negative: no overshoot).
+fn overshoot(x: &[f64], step5: &Step5) -> f64 {
+    let direction = (step5.x2 - step5.x1).signum();
+    x.iter()
+        .fold(f64::NEG_INFINITY, |m, &v| m.max((v - step5.x2) * direction))
+}
 
-        let (t1_min_time, t1_min) = extreme(t, t1, |a, b| a < b);
-        let (t1_max_time, t1_max) = extreme(t, t1, |a, b| a > b);
-        let (t2_min_time, t2_min) = extreme(t, t2, |a, b| a < b);
-        let (t2_max_time, t2_max) = extreme(t, t2, |a, b| a > b);
-        let settled_start = windows.settled_start();
-        let strict_start = context.move_end + STRICT_SETTLE_AFTER_MOVE;
-        let last = window(t, t_end - LAST_WINDOW, t_end, true, dt);
-        let transition = window(t, context.move_start, context.move_end, true, dt);
-        let settled = window(t, settled_start, t_end, true, dt);
-        let strict = window(t, strict_start, t_end, true, dt);
-        let spectral = window(t, settled_start, t_end, false, dt);
-
-        let direction = (step5.x2 - step5.x1).signum();
-        let overshoot = x
-            .iter()
-            .fold(f64::NEG_INFINITY, |m, &v| m.max((v - step5.x2) * direction));
-        let zs = &z[settled.clone()];
-        let z_p2p = peak_to_peak(zs);
-
-        let long_enough = t_end - settled_start >= MIN_SPECTRAL_WINDOW;
+impl SpectralPeaks {
+    /// The peaks of `spectra`, the main error peak the reference of the high-frequency levels.
+    fn of(spectra: Spectra) -> Self {
         let Spectra {
             z: z_spec,
             err: err_spec,
             whole,
-        } = Spectra::of(z, err, spectral, long_enough, t_end, dt, context.resolution);
+        } = spectra;
         let err_main = err_spec.refined;
         let err_hf = err_spec.high_frequency.first().copied();
         let err_hf_peak_db = err_hf.as_ref().map_or(f64::NAN, |p| db(p, err_main));
@@ -468,35 +455,7 @@ impl Metrics {
             .iter()
             .map(|p| [p.omega, db(p, err_main)])
             .collect();
-
-        let further_cables = c.tensions[c.tensions.len().min(2)..]
-            .iter()
-            .map(|v| CableTensions::of(t, v, last.clone()))
-            .collect();
-        let further_cables = FurtherCables(further_cables);
-        let mut metrics = Self {
-            model: run.model.to_owned(),
-            windows,
-            unavailable: Default::default(),
-            t1_min,
-            t1_min_time,
-            t1_max,
-            t1_max_time,
-            t2_min,
-            t2_min_time,
-            t2_max,
-            t2_max_time,
-            t1_final: t1.last().copied().unwrap_or(f64::NAN),
-            t2_final: t2.last().copied().unwrap_or(f64::NAN),
-            t1_mean_last_1s: mean(&t1[last.clone()]),
-            t2_mean_last_1s: mean(&t2[last]),
-            further_cables,
-            err_max_transition: max_abs(&err[transition]),
-            err_max_settled: max_abs(&err[settled.clone()]),
-            err_max_settled_strict: max_abs(&err[strict]),
-            overshoot,
-            z_mean: mean(zs),
-            z_p2p,
+        Self {
             z_peak_rad_s: peak_omega(z_spec.refined),
             err_peak_rad_s: peak_omega(err_main),
             z_plain_peak_rad_s: peak_omega(z_spec.plain),
@@ -516,6 +475,73 @@ impl Metrics {
             err_hf_peak_rad_s: err_hf.map_or(f64::NAN, |p| p.omega),
             err_hf_peak_db,
             err_hf_peaks,
+        }
+    }
+}
+
+impl Metrics {
+    /// Computes every metric of `run` sampled every `dt` [s] on the trajectory `step5`, with
+    /// the controller's `context` (whose move end is the shaped reference's where one is shaped).
+    pub fn from_run(run: &Run, step5: &Step5, dt: f64, context: &ControlContext) -> Self {
+        let c = Columns::of(run);
+        let (t, x, z, err) = (c.t, c.x, c.z, c.err);
+        let cable = |i: usize| c.tensions.get(i).copied().unwrap_or_default();
+        let (t1, t2) = (cable(0), cable(1));
+        let t_end = t.last().copied().unwrap_or(0.0);
+        let windows = Windows::new(context.move_start, context.move_end, t_end);
+
+        let [(t1_min_time, t1_min), (t2_min_time, t2_min)] =
+            [t1, t2].map(|v| extreme(t, v, |a, b| a < b));
+        let [(t1_max_time, t1_max), (t2_max_time, t2_max)] =
+            [t1, t2].map(|v| extreme(t, v, |a, b| a > b));
+        let settled_start = windows.settled_start();
+        let strict_start = context.move_end + STRICT_SETTLE_AFTER_MOVE;
+        let last = window(t, t_end - LAST_WINDOW, t_end, true, dt);
+        let transition = window(t, context.move_start, context.move_end, true, dt);
+        let settled = window(t, settled_start, t_end, true, dt);
+        let strict = window(t, strict_start, t_end, true, dt);
+        let spectral = window(t, settled_start, t_end, false, dt);
+
+        let zs = &z[settled.clone()];
+
+        let long_enough = t_end - settled_start >= MIN_SPECTRAL_WINDOW;
+        let spectral = SpectralPeaks::of(Spectra::of(
+            z,
+            err,
+            spectral,
+            long_enough,
+            t_end,
+            dt,
+            context.resolution,
+        ));
+        let further_cables = c.tensions[c.tensions.len().min(2)..]
+            .iter()
+            .map(|v| CableTensions::of(t, v, last.clone()))
+            .collect();
+        let mut metrics = Self {
+            model: run.model.to_owned(),
+            windows,
+            unavailable: Default::default(),
+            t1_min,
+            t1_min_time,
+            t1_max,
+            t1_max_time,
+            t2_min,
+            t2_min_time,
+            t2_max,
+            t2_max_time,
+            t1_final: t1.last().copied().unwrap_or(f64::NAN),
+            t2_final: t2.last().copied().unwrap_or(f64::NAN),
+            t1_mean_last_1s: mean(&t1[last.clone()]),
+            t2_mean_last_1s: mean(&t2[last]),
+            further_cables: FurtherCables(further_cables),
+            err_max_transition: max_abs(&err[transition]),
+            err_max_settled: max_abs(&err[settled.clone()]),
+            err_max_settled_strict: max_abs(&err[strict]),
+            overshoot: overshoot(x, step5),
+            z_mean: mean(zs),
+            z_p2p: peak_to_peak(zs),
+            spectral,
             z0: z.first().copied().unwrap_or(f64::NAN),
             f0: run.equilibrium.force(),
             energy_residual_max: max_abs(c.e_residual),
@@ -550,11 +576,11 @@ impl Metrics {
             }
             self.unavailable.entry(key.to_owned()).or_insert(why);
         }
-        if self.z_fft_record_rad_s.is_nan() {
-            self.z_fft_record_bin = 0;
+        if self.spectral.z_fft_record_rad_s.is_nan() {
+            self.spectral.z_fft_record_bin = 0;
         }
-        if self.err_hf_peak_rad_s.is_nan() {
-            self.err_hf_peaks.clear();
+        if self.spectral.err_hf_peak_rad_s.is_nan() {
+            self.spectral.err_hf_peaks.clear();
         }
     }
 
@@ -635,20 +661,20 @@ impl Metrics {
             unavailable.push(("err_hf_peak_db", why));
         } else {
             for (key, signal, kind) in spectral {
-                if let Some((_, why)) = self.no_peak.iter().find(|(k, _)| *k == key) {
+                if let Some((_, why)) = self.spectral.no_peak.iter().find(|(k, _)| *k == key) {
                     let why = format!(
                         "{signal} has no {kind} spectral peak over the settled window: {why}"
                     );
                     unavailable.push((key, why));
                 }
             }
-            if self.err_hf_peak_rad_s.is_nan() {
+            if self.spectral.err_hf_peak_rad_s.is_nan() {
                 let why = format!(
                     "the error's refined spectrum has no local maximum above {HF_FROM} rad/s"
                 );
                 unavailable.push(("err_hf_peak_rad_s", why.clone()));
                 unavailable.push(("err_hf_peak_db", why));
-            } else if self.err_peak_rad_s.is_nan() {
+            } else if self.spectral.err_peak_rad_s.is_nan() {
                 let why =
                     "its level is relative to the error's refined peak, which has none".to_string();
                 unavailable.push(("err_hf_peak_db", why));
@@ -660,6 +686,7 @@ impl Metrics {
             );
             unavailable.push(("z_fft_record_rad_s", why));
         } else if let Some((_, why)) = self
+            .spectral
             .no_peak
             .iter()
             .find(|(k, _)| *k == "z_fft_record_rad_s")
@@ -681,13 +708,13 @@ impl Metrics {
             "z_p2p" => &mut self.z_p2p,
             "t1_mean_last_1s" => &mut self.t1_mean_last_1s,
             "t2_mean_last_1s" => &mut self.t2_mean_last_1s,
-            "z_peak_rad_s" => &mut self.z_peak_rad_s,
-            "err_peak_rad_s" => &mut self.err_peak_rad_s,
-            "z_plain_peak_rad_s" => &mut self.z_plain_peak_rad_s,
-            "err_plain_peak_rad_s" => &mut self.err_plain_peak_rad_s,
-            "z_fft_record_rad_s" => &mut self.z_fft_record_rad_s,
-            "err_hf_peak_rad_s" => &mut self.err_hf_peak_rad_s,
-            "err_hf_peak_db" => &mut self.err_hf_peak_db,
+            "z_peak_rad_s" => &mut self.spectral.z_peak_rad_s,
+            "err_peak_rad_s" => &mut self.spectral.err_peak_rad_s,
+            "z_plain_peak_rad_s" => &mut self.spectral.z_plain_peak_rad_s,
+            "err_plain_peak_rad_s" => &mut self.spectral.err_plain_peak_rad_s,
+            "z_fft_record_rad_s" => &mut self.spectral.z_fft_record_rad_s,
+            "err_hf_peak_rad_s" => &mut self.spectral.err_hf_peak_rad_s,
+            "err_hf_peak_db" => &mut self.spectral.err_hf_peak_db,
             other => return self.control.set_nan(other),
         };
         *slot = f64::NAN;

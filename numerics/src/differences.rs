@@ -215,59 +215,95 @@ impl ColouredDifferences {
             if weight == 0.0 {
                 continue;
             }
-            // q'': R is linear, one forward difference is exact. q', q: central differences.
-            let central = derivative != 0;
             for g in 0..self.groups.len() {
-                for sign in [1.0, -1.0].into_iter().take(if central { 2 } else { 1 }) {
-                    for &c in &self.groups[g] {
-                        let (slot, original) = match derivative {
-                            0 => (&mut self.qdd[c], qdd[c]),
-                            1 => (&mut self.state[n + c], state[n + c]),
-                            _ => (&mut self.state[c], state[c]),
-                        };
-                        let step = if central {
-                            // Positions keep within the model's smooth reach; velocities have
-                            // no kink.
-                            let limit = if derivative == 2 {
-                                self.step_limits[c]
-                            } else {
-                                f64::INFINITY
-                            };
-                            central_step(original, limit)
-                        } else {
-                            original.abs().max(1.0)
-                        };
-                        *slot = original + sign * step;
-                        // The step actually taken, after rounding (the minus side adds to it).
-                        if sign > 0.0 {
-                            self.steps[c] = *slot - original;
-                        } else {
-                            self.steps[c] += original - *slot;
-                        }
-                    }
-                    let out = if sign > 0.0 {
-                        &mut self.probe
-                    } else {
-                        &mut self.minus
-                    };
-                    residual(&self.state, &self.qdd, out);
-                    evals += 1;
-                }
-                for &c in &self.groups[g] {
-                    let scale = weight / self.steps[c];
-                    let lower = if central { &self.minus } else { &self.base };
-                    for &(r, k) in &self.column_entries[c] {
-                        values[k] += scale * (self.probe[r] - lower[r]);
-                    }
-                    match derivative {
-                        0 => self.qdd[c] = qdd[c],
-                        1 => self.state[n + c] = state[n + c],
-                        _ => self.state[c] = state[c],
-                    }
-                }
+                evals += self.perturb_group(residual, derivative, g, state, qdd);
+                self.accumulate_group(derivative, g, weight, state, qdd, values);
             }
         }
         evals
+    }
+}
+
+impl ColouredDifferences {
+    /// The residual at group `g`'s columns of `derivative` (0: q'', 1: q', 2: q) stepped up
+    /// into `probe` and, for a central difference, stepped down into `minus`; the steps taken
+    /// (after rounding) into `steps`. Returns the residual evaluations used.
+    fn perturb_group(
+        &mut self,
+        residual: &mut ResidualFn<'_>,
+        derivative: usize,
+        g: usize,
+        state: &[f64],
+        qdd: &[f64],
+    ) -> u64 {
+        let n = self.n;
+        // q'': R is linear, one forward difference is exact. q', q: central differences.
+        let central = derivative != 0;
+        let mut evals = 0;
+        for sign in [1.0, -1.0].into_iter().take(if central { 2 } else { 1 }) {
+            for &c in &self.groups[g] {
+                let (slot, original) = match derivative {
+                    0 => (&mut self.qdd[c], qdd[c]),
+                    1 => (&mut self.state[n + c], state[n + c]),
+                    _ => (&mut self.state[c], state[c]),
+                };
+                let step = if central {
+                    // Positions keep within the model's smooth reach; velocities have no kink.
+                    let limit = if derivative == 2 {
+                        self.step_limits[c]
+                    } else {
+                        f64::INFINITY
+                    };
+                    central_step(original, limit)
+                } else {
+                    original.abs().max(1.0)
+                };
+                *slot = original + sign * step;
+                // The step actually taken, after rounding (the minus side adds to it).
+                if sign > 0.0 {
+                    self.steps[c] = *slot - original;
+                } else {
+                    self.steps[c] += original - *slot;
+                }
+            }
+            let out = if sign > 0.0 {
+                &mut self.probe
+            } else {
+                &mut self.minus
+            };
+            residual(&self.state, &self.qdd, out);
+            evals += 1;
+        }
+        evals
+    }
+
+    /// Group `g`'s differences, times `weight`, added into `values`; its columns restored.
+    fn accumulate_group(
+        &mut self,
+        derivative: usize,
+        g: usize,
+        weight: f64,
+        state: &[f64],
+        qdd: &[f64],
+        values: &mut [f64],
+    ) {
+        let n = self.n;
+        let lower = if derivative != 0 {
+            &self.minus
+        } else {
+            &self.base
+        };
+        for &c in &self.groups[g] {
+            let scale = weight / self.steps[c];
+            for &(r, k) in &self.column_entries[c] {
+                values[k] += scale * (self.probe[r] - lower[r]);
+            }
+            match derivative {
+                0 => self.qdd[c] = qdd[c],
+                1 => self.state[n + c] = state[n + c],
+                _ => self.state[c] = state[c],
+            }
+        }
     }
 }
 

@@ -74,8 +74,8 @@ fn a_short_run_has_null_metrics_with_reasons() {
         ("z_p2p", m.z_p2p),
         ("z_mean", m.z_mean),
         ("t1_mean_last_1s", m.t1_mean_last_1s),
-        ("z_peak_rad_s", m.z_peak_rad_s),
-        ("z_fft_record_rad_s", m.z_fft_record_rad_s),
+        ("z_peak_rad_s", m.spectral.z_peak_rad_s),
+        ("z_fft_record_rad_s", m.spectral.z_fft_record_rad_s),
     ] {
         assert!(value.is_nan(), "{key} = {value}");
         let why = &m.unavailable[key];

@@ -114,9 +114,9 @@ fn no_peak_on_a_flat_signal_and_no_time_beyond_the_run() {
     // The paper PID's z rings at the vertical mode: its peak is there.
     let pid = assessed("[simulation]\nt_final = 3.0\nsample_period = 1e-3\n");
     assert!(
-        (pid.metrics.z_peak_rad_s - 20.37).abs() < 0.05,
+        (pid.metrics.spectral.z_peak_rad_s - 20.37).abs() < 0.05,
         "{}",
-        pid.metrics.z_peak_rad_s
+        pid.metrics.spectral.z_peak_rad_s
     );
     // A limit the tensions sit at from the start: ΣT = 200 N rests at 100 N in each cable, and
     // t_max = 100 N (the least allowed) holds whichever is pulled harder.

@@ -39,8 +39,8 @@ pub fn write(w: &mut dyn Write, r: &ReportInputs) -> Result<()> {
         .map(|o| {
             (
                 o.kind.name(),
-                o.metrics.z_peak_rad_s,
-                o.metrics.z_fft_record_rad_s,
+                o.metrics.spectral.z_peak_rad_s,
+                o.metrics.spectral.z_fft_record_rad_s,
             )
         })
         .collect();
@@ -115,10 +115,10 @@ fn vertical_frequency(w: &mut dyn Write, r: &ReportInputs) -> Result<()> {
             o.kind,
             end.mode.omega,
             end.mode.damping_ratio(),
-            m.z_peak_rad_s,
-            m.err_peak_rad_s,
-            m.z_fft_record_rad_s,
-            m.z_fft_record_bin
+            m.spectral.z_peak_rad_s,
+            m.spectral.err_peak_rad_s,
+            m.spectral.z_fft_record_rad_s,
+            m.spectral.z_fft_record_bin
         )?;
     }
     Ok(())

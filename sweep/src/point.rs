@@ -70,11 +70,7 @@ pub fn check_all(
                         Ok(s) => {
                             let section = toml::to_string(&s.model).unwrap_or_default();
                             let samples = cdpr_bench::memory::samples(&s);
-                            match mine.iter_mut().find(|(m, _, _)| *m == section) {
-                                Some(slot) if slot.1 >= samples => {}
-                                Some(slot) => *slot = (section, samples, i),
-                                None => mine.push((section, samples, i)),
-                            }
+                            keep_largest(&mut mine, (section, samples, i));
                         }
                         Err(e) => {
                             let mut f = failure.lock().expect("no worker panics");
@@ -88,12 +84,8 @@ pub fn check_all(
                 }
                 running.fetch_sub(1, Ordering::Relaxed);
                 let mut all = largest.lock().expect("no worker panics");
-                for (section, samples, i) in mine {
-                    match all.iter_mut().find(|(m, _, _)| *m == section) {
-                        Some(slot) if slot.1 > samples || (slot.1 == samples && slot.2 < i) => {}
-                        Some(slot) => *slot = (section, samples, i),
-                        None => all.push((section, samples, i)),
-                    }
+                for candidate in mine {
+                    keep_largest(&mut all, candidate);
                 }
             });
         }
@@ -109,11 +101,28 @@ pub fn check_all(
         return Err(SweepError::Interrupted("checking the grid's points"));
     }
     progress(total, total);
+    hungriest(grid, largest.into_inner().expect("no worker panics"))
+}
+
+/// Per model section, the point with the most samples (section, samples, point): `candidate`
+/// replaces its section's entry when it has more samples, or as many at a lower point (so the
+/// choice does not depend on which worker checked which point).
+fn keep_largest(largest: &mut Vec<(String, f64, usize)>, candidate: (String, f64, usize)) {
+    let (section, samples, i) = candidate;
+    match largest.iter_mut().find(|(m, _, _)| *m == section) {
+        Some(slot) if slot.1 > samples || (slot.1 == samples && slot.2 < i) => {}
+        Some(slot) => *slot = (section, samples, i),
+        None => largest.push((section, samples, i)),
+    }
+}
+
+/// Of each section's largest point, the one whose run needs the most memory.
+fn hungriest(grid: &Grid, largest: Vec<(String, f64, usize)>) -> Result<Checked, SweepError> {
     let mut checked = Checked {
         largest: 0,
         largest_bytes: 0.0,
     };
-    for (_, _, i) in largest.into_inner().expect("no worker panics") {
+    for (_, _, i) in largest {
         let s = scenario(grid, &grid.point(i))?;
         let bytes = cdpr_bench::memory::run_memory(&s).map_err(|e| SweepError::Point {
             index: i,

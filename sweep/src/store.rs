@@ -149,19 +149,13 @@ fn same_results(a: &Record, b: &Record) -> bool {
     *a == b
 }
 
-/// Reads a results file and checks every record (a torn last line is dropped; a point recorded
-/// twice with the same results is kept once; anything else is an error naming the line).
-/// `expected`: the grid the file must belong to (a sweep's; None for a merge's inputs).
-pub fn scan(path: &Path, expected: Option<&Grid>) -> Result<Scan, SweepError> {
-    let file = File::open(path).map_err(|e| SweepError::io(path, e))?;
-    let mut reader = BufReader::with_capacity(1 << 20, file);
-    let mut line = String::new();
-    let mut offset: u64 = 0;
-    let read = |reader: &mut BufReader<File>, line: &mut String| {
-        line.clear();
-        reader.read_line(line).map_err(|e| SweepError::io(path, e))
-    };
-    let n = read(&mut reader, &mut line)?;
+/// The header `line` of the results file at `path` read and checked: this version's format,
+/// a grid it describes, and `expected`'s grid where one is given.
+fn checked_header(
+    path: &Path,
+    line: &str,
+    expected: Option<&Grid>,
+) -> Result<(Header, Grid), SweepError> {
     let header: Header = (line.ends_with('\n'))
         .then(|| serde_json::from_str(line.trim_end()).ok())
         .flatten()
@@ -202,6 +196,47 @@ pub fn scan(path: &Path, expected: Option<&Grid>) -> Result<Scan, SweepError> {
             ),
         ));
     }
+    Ok((header, grid))
+}
+
+/// A point's `record` on line `line_no` that was recorded before (`first`, read back from
+/// `file`): kept once if the results agree, an error naming both lines if not.
+fn check_repeat(
+    path: &Path,
+    file: &mut File,
+    first: &Entry,
+    record: &Record,
+    line_no: usize,
+) -> Result<(), SweepError> {
+    let earlier: Record = serde_json::from_str(&read_line(file, path, first)?)
+        .map_err(|e| results_error(path, format!("line {}: {e}", first.line)))?;
+    if same_results(&earlier, record) {
+        Ok(())
+    } else {
+        Err(results_error(
+            path,
+            format!(
+                "point {} is recorded twice with different results (lines {} and {line_no})",
+                record.point, first.line
+            ),
+        ))
+    }
+}
+
+/// Reads a results file and checks every record (a torn last line is dropped; a point recorded
+/// twice with the same results is kept once; anything else is an error naming the line).
+/// `expected`: the grid the file must belong to (a sweep's; None for a merge's inputs).
+pub fn scan(path: &Path, expected: Option<&Grid>) -> Result<Scan, SweepError> {
+    let file = File::open(path).map_err(|e| SweepError::io(path, e))?;
+    let mut reader = BufReader::with_capacity(1 << 20, file);
+    let mut line = String::new();
+    let mut offset: u64 = 0;
+    let read = |reader: &mut BufReader<File>, line: &mut String| {
+        line.clear();
+        reader.read_line(line).map_err(|e| SweepError::io(path, e))
+    };
+    let n = read(&mut reader, &mut line)?;
+    let (header, grid) = checked_header(path, &line, expected)?;
     offset += n as u64;
     let mut seen: Vec<Option<u32>> = vec![None; grid.len()];
     let mut entries: Vec<Entry> = Vec::new();
@@ -228,22 +263,11 @@ pub fn scan(path: &Path, expected: Option<&Grid>) -> Result<Scan, SweepError> {
                 entries.push(entry);
             }
             Some(k) => {
-                let first = entries[k as usize];
                 let file = match &mut reopened {
                     Some(f) => f,
                     None => reopened.insert(File::open(path).map_err(|e| SweepError::io(path, e))?),
                 };
-                let earlier: Record = serde_json::from_str(&read_line(file, path, &first)?)
-                    .map_err(|e| results_error(path, format!("line {}: {e}", first.line)))?;
-                if !same_results(&earlier, &record) {
-                    return Err(results_error(
-                        path,
-                        format!(
-                            "point {} is recorded twice with different results (lines {} and {line_no})",
-                            record.point, first.line
-                        ),
-                    ));
-                }
+                check_repeat(path, file, &entries[k as usize], &record, line_no)?;
             }
         }
     }
@@ -447,6 +471,16 @@ pub fn merge(
     }
     std::fs::create_dir_all(out).map_err(|e| SweepError::io(out, e))?;
     let _lock = DirLock::acquire(out, "merge")?;
+    let mut scans = scan_inputs(inputs)?;
+    let owner = keep_each_point_once(&mut scans)?;
+    let header = scans[0].header.clone();
+    let n = owner.iter().filter(|o| o.is_some()).count();
+    write_sorted(out, &scans, stop)?;
+    Ok((header, n))
+}
+
+/// Each input (a results file, or a directory holding one) scanned; all must be of one grid.
+fn scan_inputs(inputs: &[PathBuf]) -> Result<Vec<Scan>, SweepError> {
     let mut scans: Vec<Scan> = Vec::new();
     for dir in inputs {
         let path = if dir.is_dir() {
@@ -470,7 +504,12 @@ pub fn merge(
         }
         scans.push(scan);
     }
-    // Each point once: a later input's record of a point already seen must agree with it.
+    Ok(scans)
+}
+
+/// Each point once: a later input's record of a point already seen must agree with it, and is
+/// dropped from that input's entries. Returns each point's owner (input, entry).
+fn keep_each_point_once(scans: &mut [Scan]) -> Result<Vec<Option<(usize, Entry)>>, SweepError> {
     let points = scans[0].header.points;
     let mut owner: Vec<Option<(usize, Entry)>> = vec![None; points];
     let mut files: Vec<Option<File>> = (0..scans.len()).map(|_| None).collect();
@@ -483,18 +522,8 @@ pub fn merge(
                     kept.push(entry);
                 }
                 Some((j, first)) => {
-                    let mut read = |i: usize, e: &Entry| -> Result<Record, SweepError> {
-                        let path = &scans[i].path;
-                        let file = match &mut files[i] {
-                            Some(f) => f,
-                            slot => {
-                                slot.insert(File::open(path).map_err(|e| SweepError::io(path, e))?)
-                            }
-                        };
-                        serde_json::from_str(&read_line(file, path, e)?)
-                            .map_err(|err| results_error(path, format!("line {}: {err}", e.line)))
-                    };
-                    let (a, b) = (read(j, &first)?, read(k, &entry)?);
+                    let a = read_entry(&scans[j], &mut files[j], &first)?;
+                    let b = read_entry(&scans[k], &mut files[k], &entry)?;
                     if !same_results(&a, &b) {
                         return Err(results_error(
                             &scans[k].path,
@@ -511,10 +540,18 @@ pub fn merge(
         }
         scans[k].entries = kept;
     }
-    let header = scans[0].header.clone();
-    let n = owner.iter().filter(|o| o.is_some()).count();
-    write_sorted(out, &scans, stop)?;
-    Ok((header, n))
+    Ok(owner)
+}
+
+/// The record of `entry` in `scan`'s file (opened into `file` on first use).
+fn read_entry(scan: &Scan, file: &mut Option<File>, entry: &Entry) -> Result<Record, SweepError> {
+    let path = &scan.path;
+    let file = match file {
+        Some(f) => f,
+        slot => slot.insert(File::open(path).map_err(|e| SweepError::io(path, e))?),
+    };
+    serde_json::from_str(&read_line(file, path, entry)?)
+        .map_err(|err| results_error(path, format!("line {}: {err}", entry.line)))
 }
 
 /// Every record of a results file, checked, in file order (held in memory: for callers that

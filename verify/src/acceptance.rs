@@ -350,7 +350,10 @@ fn spectrum_rows(r: &ModelResult) -> Vec<Check> {
             of: "the closed-loop vertical mode",
         }),
     );
-    for (signal, omega) in [("z", m.z_peak_rad_s), ("error", m.err_peak_rad_s)] {
+    for (signal, omega) in [
+        ("z", m.spectral.z_peak_rad_s),
+        ("error", m.spectral.err_peak_rad_s),
+    ] {
         rows.push(check(
             &format!("{signal} refined spectral peak over [1, 5] s"),
             name,
@@ -366,10 +369,11 @@ fn spectrum_rows(r: &ModelResult) -> Vec<Check> {
         "20.11 rad/s",
         format!(
             "{:.4} rad/s (bin {})",
-            m.z_fft_record_rad_s, m.z_fft_record_bin
+            m.spectral.z_fft_record_rad_s, m.spectral.z_fft_record_bin
         ),
         &format!("bin {FFT_BIN}, |ω − {FFT_OMEGA}| < {FFT_TOLERANCE} rad/s"),
-        m.z_fft_record_bin == FFT_BIN && (m.z_fft_record_rad_s - FFT_OMEGA).abs() < FFT_TOLERANCE,
+        m.spectral.z_fft_record_bin == FFT_BIN
+            && (m.spectral.z_fft_record_rad_s - FFT_OMEGA).abs() < FFT_TOLERANCE,
     ));
     rows
 }
@@ -381,7 +385,7 @@ fn high_frequency_row(r: &ModelResult) -> Check {
     let quantity = "high-frequency content of the error spectrum";
     let hf = format!(
         "{:.1} rad/s at {:.1} dB",
-        m.err_hf_peak_rad_s, m.err_hf_peak_db
+        m.spectral.err_hf_peak_rad_s, m.spectral.err_hf_peak_db
     );
     match r.kind {
         ModelKind::Elastic => row(
@@ -394,10 +398,10 @@ fn high_frequency_row(r: &ModelResult) -> Check {
                 minus(ELASTIC_HF_DB)
             ),
             // No local maximum at all (NaN) is "nothing" too.
-            m.err_hf_peak_db.is_nan() || m.err_hf_peak_db < ELASTIC_HF_DB,
+            m.spectral.err_hf_peak_db.is_nan() || m.spectral.err_hf_peak_db < ELASTIC_HF_DB,
         ),
         ModelKind::Lumped => {
-            let axial = m.err_hf_peaks.iter().find(|[w, db]| {
+            let axial = m.spectral.err_hf_peaks.iter().find(|[w, db]| {
                 (w / r.axial_mode - 1.0).abs() <= AXIAL_PERCENT / 100.0 && *db >= AXIAL_DB
             });
             let target = match r.integrator {

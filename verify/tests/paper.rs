@@ -78,9 +78,9 @@ fn paper_scenario_meets_every_section_8_row_with_every_model() {
     // −98 dB, far below the lumped model's −21 dB); FE.11.10, the closed-loop energy balance
     // below 1e-6 J (MODELS.md reference 3.6e-7 J; measured 1.3e-9 J with β = 0.04).
     assert!(
-        fe.metrics.err_hf_peak_db < -60.0,
+        fe.metrics.spectral.err_hf_peak_db < -60.0,
         "{} dB",
-        fe.metrics.err_hf_peak_db
+        fe.metrics.spectral.err_hf_peak_db
     );
     assert!(
         fe.metrics.energy_residual_max < 1e-6,

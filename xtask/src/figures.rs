@@ -14,6 +14,7 @@ use cdpr_bench::ModelKind;
 
 use cdpr_bench::core::runner::Run;
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 use std::path::Path;
@@ -225,35 +226,7 @@ fn draw_panel<DB: DrawingBackend>(
     scale: f64,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let px = |v: f64| (v * scale).round() as u32;
-    let tx = |x: f64| if panel.log_x { x.log10() } else { x };
-    let ty = |y: f64| {
-        if panel.log_y {
-            y.abs().max(1e-300).log10()
-        } else {
-            y
-        }
-    };
-    let valid = |p: &&(f64, f64)| (!panel.log_x || p.0 > 0.0) && (!panel.log_y || p.1 != 0.0);
-    let all = || {
-        panel
-            .lines
-            .iter()
-            .flat_map(|l| l.points.iter().filter(valid))
-    };
-    let (mut x0, mut x1) = bounds(all().map(|p| tx(p.0)));
-    let (mut y0, mut y1) = bounds(all().map(|p| ty(p.1)));
-    if panel.log_x {
-        (x0, x1) = (x0.floor(), x1.ceil());
-    }
-    if panel.log_y {
-        (y0, y1) = (y0.floor(), y1.ceil());
-    }
-    for m in &panel.markers {
-        match m {
-            Marker::Horizontal(y, _) => (y0, y1) = (y0.min(ty(*y)), y1.max(ty(*y))),
-            Marker::Vertical(x, _) => (x0, x1) = (x0.min(tx(*x)), x1.max(tx(*x))),
-        }
-    }
+    let ((x0, x1), (y0, y1)) = panel_ranges(panel);
     let label_font = ("sans-serif", px(14.0)).into_font();
     let mut chart = ChartBuilder::on(area)
         .margin(px(8.0))
@@ -298,12 +271,74 @@ fn draw_panel<DB: DrawingBackend>(
     // Reference lines; their labels go to the legend, where they collide with nothing.
     for m in &panel.markers {
         let points = match m {
-            Marker::Vertical(x, _) => vec![(tx(*x), y0), (tx(*x), y1)],
-            Marker::Horizontal(y, _) => vec![(x0, ty(*y)), (x1, ty(*y))],
+            Marker::Vertical(x, _) => vec![(panel.plot_x(*x), y0), (panel.plot_x(*x), y1)],
+            Marker::Horizontal(y, _) => vec![(x0, panel.plot_y(*y)), (x1, panel.plot_y(*y))],
         };
         let grey = MARKER_GREY.stroke_width(px(1.0));
         chart.draw_series(DashedLineSeries::new(points, px(6.0), px(4.0), grey))?;
     }
+    draw_lines(&mut chart, panel, scale)?;
+    draw_legend(area, &chart, panel, scale)
+}
+
+/// The plotted ranges of `panel` (in the plotted, possibly log10, coordinates): its valid data
+/// and its markers, whole decades on a log axis.
+fn panel_ranges(panel: &Panel) -> ((f64, f64), (f64, f64)) {
+    let all = || {
+        panel
+            .lines
+            .iter()
+            .flat_map(|l| l.points.iter().filter(|p| panel.plottable(p)))
+    };
+    let (mut x0, mut x1) = bounds(all().map(|p| panel.plot_x(p.0)));
+    let (mut y0, mut y1) = bounds(all().map(|p| panel.plot_y(p.1)));
+    if panel.log_x {
+        (x0, x1) = (x0.floor(), x1.ceil());
+    }
+    if panel.log_y {
+        (y0, y1) = (y0.floor(), y1.ceil());
+    }
+    for m in &panel.markers {
+        match m {
+            Marker::Horizontal(y, _) => {
+                (y0, y1) = (y0.min(panel.plot_y(*y)), y1.max(panel.plot_y(*y)))
+            }
+            Marker::Vertical(x, _) => {
+                (x0, x1) = (x0.min(panel.plot_x(*x)), x1.max(panel.plot_x(*x)))
+            }
+        }
+    }
+    ((x0, x1), (y0, y1))
+}
+
+impl Panel {
+    /// x in the plotted coordinate (log10 on a log axis).
+    fn plot_x(&self, x: f64) -> f64 {
+        if self.log_x { x.log10() } else { x }
+    }
+
+    /// y in the plotted coordinate (log10 of |y| on a log axis).
+    fn plot_y(&self, y: f64) -> f64 {
+        if self.log_y {
+            y.abs().max(1e-300).log10()
+        } else {
+            y
+        }
+    }
+
+    /// A point a log axis can show.
+    fn plottable(&self, p: &(f64, f64)) -> bool {
+        (!self.log_x || p.0 > 0.0) && (!self.log_y || p.1 != 0.0)
+    }
+}
+
+/// The panel's data lines onto `chart`.
+fn draw_lines<DB: DrawingBackend>(
+    chart: &mut ChartContext<DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    panel: &Panel,
+    scale: f64,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let px = |v: f64| (v * scale).round() as u32;
     // Draw order: lines that oscillate far more than the others (a band, like the lumped
     // model's tensions while its axial mode rings) first, so the smoother curves stay visible on
     // top; among comparable lines the wider first, so a narrower one drawn over a coinciding
@@ -322,8 +357,8 @@ fn draw_panel<DB: DrawingBackend>(
         let pts: Vec<(f64, f64)> = line
             .points
             .iter()
-            .filter(valid)
-            .map(|p| (tx(p.0), ty(p.1)))
+            .filter(|p| panel.plottable(p))
+            .map(|p| (panel.plot_x(p.0), panel.plot_y(p.1)))
             .collect();
         if line.dashed {
             chart.draw_series(DashedLineSeries::new(pts, px(8.0), px(5.0), style))?;
@@ -336,7 +371,7 @@ fn draw_panel<DB: DrawingBackend>(
             )?;
         }
     }
-    draw_legend(area, &chart, panel, scale)
+    Ok(())
 }
 
 /// Opacity of the data lines.

@@ -94,73 +94,92 @@ impl Drawing for HeatMap {
             .titled(&self.title, ("sans-serif", px(18.0)).into_font())
             .map_err(err)?;
         let (plots, bar) = titled.split_horizontally(titled.dim_in_pixel().0 - px(110.0));
-        let (lo, hi) = self.range();
+        let range = self.range();
         let areas = plots.split_evenly((self.rows, self.cols));
         for (panel, area) in self.panels.iter().zip(areas.iter()) {
-            let nx = panel.x_labels.len();
-            let ny = panel.y_labels.len();
-            let mut chart = ChartBuilder::on(area)
-                .caption(&panel.title, ("sans-serif", px(14.0)).into_font())
-                .margin(px(6.0))
-                .x_label_area_size(px(34.0))
-                .y_label_area_size(px(44.0))
-                .build_cartesian_2d(0.0..nx as f64, 0.0..ny as f64)
-                .map_err(err)?;
-            let xl = |v: &f64| cell_label(&panel.x_labels, *v);
-            let yl = |v: &f64| cell_label(&panel.y_labels, *v);
-            chart
-                .configure_mesh()
-                .disable_mesh()
-                .x_labels(2 * nx + 1)
-                .y_labels(2 * ny + 1)
-                .x_label_formatter(&xl)
-                .y_label_formatter(&yl)
-                .x_desc(&self.x_name)
-                .y_desc(&self.y_name)
-                .label_style(("sans-serif", px(11.0)).into_font())
-                .axis_desc_style(("sans-serif", px(12.0)).into_font())
-                .draw()
-                .map_err(err)?;
-            for (iy, row) in panel.values.iter().enumerate() {
-                for (ix, v) in row.iter().enumerate() {
-                    let (x, y) = (ix as f64, iy as f64);
-                    match v {
-                        Some(v) if v.is_finite() && *v > 0.0 => {
-                            let f = (v.log10() - lo) / (hi - lo);
-                            chart
-                                .draw_series(std::iter::once(Rectangle::new(
-                                    [(x, y), (x + 1.0, y + 1.0)],
-                                    color(f).filled(),
-                                )))
-                                .map_err(err)?;
-                        }
-                        _ => {
-                            let grey = RGBColor(160, 160, 160);
-                            chart
-                                .draw_series([
-                                    PathElement::new(
-                                        vec![(x + 0.2, y + 0.2), (x + 0.8, y + 0.8)],
-                                        grey.stroke_width(px(2.0)),
-                                    ),
-                                    PathElement::new(
-                                        vec![(x + 0.2, y + 0.8), (x + 0.8, y + 0.2)],
-                                        grey.stroke_width(px(2.0)),
-                                    ),
-                                ])
-                                .map_err(err)?;
-                        }
+            self.draw_panel(panel, area, range, scale).map_err(err)?;
+        }
+        self.draw_colour_bar(&bar, range, scale).map_err(err)
+    }
+}
+
+impl HeatMap {
+    /// One panel's cells, coloured by log10 of the value on `lo..hi`; a cell without a positive
+    /// finite value crossed out.
+    fn draw_panel<DB: DrawingBackend>(
+        &self,
+        panel: &HeatPanel,
+        area: &DrawingArea<DB, Shift>,
+        (lo, hi): (f64, f64),
+        scale: f64,
+    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+        let px = |v: f64| (v * scale).round() as u32;
+        let nx = panel.x_labels.len();
+        let ny = panel.y_labels.len();
+        let mut chart = ChartBuilder::on(area)
+            .caption(&panel.title, ("sans-serif", px(14.0)).into_font())
+            .margin(px(6.0))
+            .x_label_area_size(px(34.0))
+            .y_label_area_size(px(44.0))
+            .build_cartesian_2d(0.0..nx as f64, 0.0..ny as f64)?;
+        let xl = |v: &f64| cell_label(&panel.x_labels, *v);
+        let yl = |v: &f64| cell_label(&panel.y_labels, *v);
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_labels(2 * nx + 1)
+            .y_labels(2 * ny + 1)
+            .x_label_formatter(&xl)
+            .y_label_formatter(&yl)
+            .x_desc(&self.x_name)
+            .y_desc(&self.y_name)
+            .label_style(("sans-serif", px(11.0)).into_font())
+            .axis_desc_style(("sans-serif", px(12.0)).into_font())
+            .draw()?;
+        for (iy, row) in panel.values.iter().enumerate() {
+            for (ix, v) in row.iter().enumerate() {
+                let (x, y) = (ix as f64, iy as f64);
+                match v {
+                    Some(v) if v.is_finite() && *v > 0.0 => {
+                        let f = (v.log10() - lo) / (hi - lo);
+                        chart.draw_series(std::iter::once(Rectangle::new(
+                            [(x, y), (x + 1.0, y + 1.0)],
+                            color(f).filled(),
+                        )))?;
+                    }
+                    _ => {
+                        let grey = RGBColor(160, 160, 160);
+                        chart.draw_series([
+                            PathElement::new(
+                                vec![(x + 0.2, y + 0.2), (x + 0.8, y + 0.8)],
+                                grey.stroke_width(px(2.0)),
+                            ),
+                            PathElement::new(
+                                vec![(x + 0.2, y + 0.8), (x + 0.8, y + 0.2)],
+                                grey.stroke_width(px(2.0)),
+                            ),
+                        ])?;
                     }
                 }
             }
         }
-        // Colour bar: log10 of the value.
-        let mut chart = ChartBuilder::on(&bar)
+        Ok(())
+    }
+
+    /// The colour bar: log10 of the value on `lo..hi`.
+    fn draw_colour_bar<DB: DrawingBackend>(
+        &self,
+        bar: &DrawingArea<DB, Shift>,
+        (lo, hi): (f64, f64),
+        scale: f64,
+    ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+        let px = |v: f64| (v * scale).round() as u32;
+        let mut chart = ChartBuilder::on(bar)
             .margin(px(20.0))
             .margin_left(px(10.0))
             .y_label_area_size(px(50.0))
             .caption(&self.value_name, ("sans-serif", px(12.0)).into_font())
-            .build_cartesian_2d(0.0..1.0, lo..hi)
-            .map_err(err)?;
+            .build_cartesian_2d(0.0..1.0, lo..hi)?;
         chart
             .configure_mesh()
             .disable_mesh()
@@ -168,17 +187,14 @@ impl Drawing for HeatMap {
             .y_labels(((hi - lo).ceil() as usize + 1).max(2))
             .y_label_formatter(&|v| power_label(v))
             .label_style(("sans-serif", px(11.0)).into_font())
-            .draw()
-            .map_err(err)?;
+            .draw()?;
         let steps = 64;
         for k in 0..steps {
             let (a, b) = (k as f64 / steps as f64, (k + 1) as f64 / steps as f64);
-            chart
-                .draw_series(std::iter::once(Rectangle::new(
-                    [(0.0, lo + a * (hi - lo)), (1.0, lo + b * (hi - lo))],
-                    color(0.5 * (a + b)).filled(),
-                )))
-                .map_err(err)?;
+            chart.draw_series(std::iter::once(Rectangle::new(
+                [(0.0, lo + a * (hi - lo)), (1.0, lo + b * (hi - lo))],
+                color(0.5 * (a + b)).filled(),
+            )))?;
         }
         Ok(())
     }

@@ -241,8 +241,18 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
-    let result = match cli.command {
+    match run(Cli::parse().command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// One command, carried out.
+fn run(command: Command) -> anyhow::Result<()> {
+    match command {
         Command::Simulate {
             scenario,
             model,
@@ -313,12 +323,5 @@ fn main() -> ExitCode {
                 steps: tension_steps,
             },
         ),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
     }
 }

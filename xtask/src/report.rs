@@ -86,24 +86,7 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
     let (x1, x2) = (base.trajectory.x1, base.trajectory.x2);
     let modes = cdpr_studies::modes::compute(&base, &[x1, x2], x2)?;
     crate::modes::write_files(&modes, out)?;
-    // Every controller on every model (the leaderboard, ~2 s on two cores).
-    let control = cdpr_studies::control::compute(&base)?;
-    let control_figures = crate::control::write(&control, out)?;
-    // Every input shaper on every model with the paper's PID (~40 s on two cores).
-    let shaping = cdpr_studies::shaping::compute(&base)?;
-    let shaping_figures = crate::shaping::write(&shaping, out)?;
-    // The mass × move-time parameter studies on every model: controllers (150 points) and
-    // shapers (225 points), ~45 s on two cores.
-    let mut study_section = String::from(
-        "## Parameter studies\n\nBeyond the paper: the paper's move x 0.5 → 0.6 m with effector mass \
-         0.25–4 kg (log) × move end t2 0.1–0.5 s on each cable model, samples every 0.1 ms.\n\n",
-    );
-    for spec in cdpr_studies::sweeps::STUDIES {
-        let study = cdpr_studies::sweeps::compute(spec, &base, out)?;
-        let figures = crate::sweep_study::write(&study, out)?;
-        study_section.push_str(&study.section(&figures));
-    }
-    study_section.push_str(&printing_section(out)?);
+    let control_section = beyond_the_paper(&base, out)?;
     write_json(
         &out.join("metrics.json"),
         &ReportFile {
@@ -121,13 +104,6 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
             checks: &checks,
         },
     )?;
-    let control_section = format!(
-        "{}\n## Input shaping with the paper's PID\n\nBeyond the paper (`cargo xtask shaping`; shaping.csv has \
-         every run).\n\n{}\n{}",
-        control.section(&control_figures),
-        shaping.section(&shaping_figures),
-        study_section
-    );
     write_markdown(
         &base,
         &outcomes,
@@ -155,6 +131,37 @@ pub fn run(scenario: Option<&Path>, out: &Path) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The studies beyond the paper, their files into `out`: every controller on every model, every
+/// input shaper with the paper's PID, the parameter studies and the printing frontier. Returns
+/// their sections of REPORT.md.
+fn beyond_the_paper(base: &Scenario, out: &Path) -> Result<String> {
+    // Every controller on every model (the leaderboard, ~2 s on two cores).
+    let control = cdpr_studies::control::compute(base)?;
+    let control_figures = crate::control::write(&control, out)?;
+    // Every input shaper on every model with the paper's PID (~40 s on two cores).
+    let shaping = cdpr_studies::shaping::compute(base)?;
+    let shaping_figures = crate::shaping::write(&shaping, out)?;
+    // The mass × move-time parameter studies on every model: controllers (150 points) and
+    // shapers (225 points), ~45 s on two cores.
+    let mut study_section = String::from(
+        "## Parameter studies\n\nBeyond the paper: the paper's move x 0.5 → 0.6 m with effector mass \
+         0.25–4 kg (log) × move end t2 0.1–0.5 s on each cable model, samples every 0.1 ms.\n\n",
+    );
+    for spec in cdpr_studies::sweeps::STUDIES {
+        let study = cdpr_studies::sweeps::compute(spec, base, out)?;
+        let figures = crate::sweep_study::write(&study, out)?;
+        study_section.push_str(&study.section(&figures));
+    }
+    study_section.push_str(&printing_section(out)?);
+    Ok(format!(
+        "{}\n## Input shaping with the paper's PID\n\nBeyond the paper (`cargo xtask shaping`; shaping.csv has \
+         every run).\n\n{}\n{}",
+        control.section(&control_figures),
+        shaping.section(&shaping_figures),
+        study_section
+    ))
 }
 
 /// The printer's speed–accuracy frontier (160 prints of two first layers, ~30 s on two cores):

@@ -83,43 +83,58 @@ pub fn run_study(out: &Path) -> Result<()> {
     crate::simulate::writable_out(out)?;
     let mut points = Vec::new();
     for model in ModelKind::MASSIVE {
-        eprintln!("{model}: reference (DOPRI5, rtol {REFERENCE_RTOL:e})");
-        let mut reference_scenario = scenario(model, IntegratorKind::Dopri5, REFERENCE_RTOL)?;
-        reference_scenario.simulation.atol = 1e-14;
-        let reference = cdpr_bench::simulate(&reference_scenario, &mut |_| {})?;
-        let sweeps = RTOLS
-            .iter()
-            .map(|&p| (IntegratorKind::Dopri5, p))
-            .chain(STEPS.iter().map(|&p| (IntegratorKind::Implicit, p)));
-        for (integrator, parameter) in sweeps {
-            let r = run(&scenario(model, integrator, parameter)?)?;
-            let point = Point {
-                model,
-                integrator,
-                parameter,
-                error: error(&r, &reference)?,
-                wall_s: r.wall_s,
-                rhs_evals: r.stats.rhs_evals,
-                steps: r.stats.steps_accepted,
-                newton_iterations: r.stats.newton_iterations,
-                factorisations: r.stats.factorisations,
-            };
-            eprintln!(
-                "{model} {} {parameter:e}: error {:.3e} m, {:.4} s, {} RHS",
-                point.integrator.name(),
-                point.error,
-                point.wall_s,
-                point.rhs_evals
-            );
-            points.push(point);
-        }
+        points.extend(model_points(model)?);
     }
-    write_atomic(&out.join("work_precision.csv"), |w| {
+    write_csv(&out.join("work_precision.csv"), &points)?;
+    write_figure(&points, out)?;
+    eprintln!("→ {}", out.join("work_precision.csv").display());
+    Ok(())
+}
+
+/// `model`'s reference run, then its points: DOPRI5 at each of [`RTOLS`], generalised-α at
+/// each of [`STEPS`].
+fn model_points(model: ModelKind) -> Result<Vec<Point>> {
+    eprintln!("{model}: reference (DOPRI5, rtol {REFERENCE_RTOL:e})");
+    let mut reference_scenario = scenario(model, IntegratorKind::Dopri5, REFERENCE_RTOL)?;
+    reference_scenario.simulation.atol = 1e-14;
+    let reference = cdpr_bench::simulate(&reference_scenario, &mut |_| {})?;
+    let sweeps = RTOLS
+        .iter()
+        .map(|&p| (IntegratorKind::Dopri5, p))
+        .chain(STEPS.iter().map(|&p| (IntegratorKind::Implicit, p)));
+    let mut points = Vec::new();
+    for (integrator, parameter) in sweeps {
+        let r = run(&scenario(model, integrator, parameter)?)?;
+        let point = Point {
+            model,
+            integrator,
+            parameter,
+            error: error(&r, &reference)?,
+            wall_s: r.wall_s,
+            rhs_evals: r.stats.rhs_evals,
+            steps: r.stats.steps_accepted,
+            newton_iterations: r.stats.newton_iterations,
+            factorisations: r.stats.factorisations,
+        };
+        eprintln!(
+            "{model} {} {parameter:e}: error {:.3e} m, {:.4} s, {} RHS",
+            point.integrator.name(),
+            point.error,
+            point.wall_s,
+            point.rhs_evals
+        );
+        points.push(point);
+    }
+    Ok(points)
+}
+
+fn write_csv(path: &Path, points: &[Point]) -> Result<()> {
+    write_atomic(path, |w| {
         writeln!(
             w,
             "model,integrator,parameter,error_m,wall_s,rhs_evals,steps,newton_iterations,factorisations"
         )?;
-        for p in &points {
+        for p in points {
             writeln!(
                 w,
                 "{},{},{},{},{},{},{},{},{}",
@@ -136,6 +151,11 @@ pub fn run_study(out: &Path) -> Result<()> {
         }
         Ok(())
     })?;
+    Ok(())
+}
+
+/// Error against wall time and against RHS evaluations, a line per model and integrator.
+fn write_figure(points: &[Point], out: &Path) -> Result<()> {
     let panel = |cost: &str, f: fn(&Point) -> f64| Panel {
         x_label: cost.into(),
         y_label: "max |effector − reference| over [0, 0.25] s [m]".into(),
@@ -144,7 +164,6 @@ pub fn run_study(out: &Path) -> Result<()> {
         lines: ModelKind::MASSIVE
             .into_iter()
             .flat_map(|model| {
-                let points = &points;
                 [IntegratorKind::Dopri5, IntegratorKind::Implicit]
                     .into_iter()
                     .map(move |integrator| Line {
@@ -181,6 +200,5 @@ pub fn run_study(out: &Path) -> Result<()> {
         },
         out,
     )?;
-    eprintln!("→ {}", out.join("work_precision.csv").display());
     Ok(())
 }

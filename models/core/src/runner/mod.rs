@@ -262,26 +262,7 @@ fn integrate_and_sample<M: CableModel<D>, const D: usize>(
     observer: &mut Observer,
 ) -> Result<Run, Box<RunFailure>> {
     let start = Instant::now();
-    let n = sys.model_len();
-    let names = channel_names(&sys.model);
-    let samples = (opts.t_final / opts.sample_period).round() as usize + 1;
-    let mut sampler = Sampler {
-        series: TimeSeries::with_buffer(names, samples, buffer),
-        y: vec![0.0; y0.len()],
-        model_channels: sys.model.channel_names().len(),
-        l0_channels: (1..=sys.model.cables())
-            .filter_map(|i| {
-                let name = format!("l0_{i}");
-                sys.model.channel_names().iter().position(|c| *c == name)
-            })
-            .collect(),
-        energy0: sys.model.energy(&y0[..n]).total(),
-        event_energy: 0.0,
-        next: 0,
-        samples,
-        period: opts.sample_period,
-        t_final: opts.t_final,
-    };
+    let mut sampler = Sampler::new(sys, &y0, opts, buffer);
     let mut events = Vec::new();
     let mut dopri;
     let mut alpha;
@@ -301,16 +282,9 @@ fn integrate_and_sample<M: CableModel<D>, const D: usize>(
             &mut alpha
         }
     };
-    let outcome = if sys.shaper.is_none() {
-        Err(RunError::UnresolvedShaper)
-    } else if opts.integrator == IntegratorKind::Implicit && sys.model.second_order().is_none() {
-        Err(RunError::Unsupported {
-            integrator: IntegratorKind::Implicit.name(),
-            model: sys.model.name(),
-            why: "the model offers no second-order form",
-        })
-    } else {
-        integrate(
+    let outcome = match unsupported(sys, opts) {
+        Some(error) => Err(error),
+        None => integrate(
             sys,
             &y0,
             opts.t_final,
@@ -318,7 +292,7 @@ fn integrate_and_sample<M: CableModel<D>, const D: usize>(
             &mut sampler,
             &mut events,
             observer,
-        )
+        ),
     };
     let t_reached = if stepper.stats().rhs_evals == 0 {
         0.0
@@ -346,6 +320,25 @@ fn integrate_and_sample<M: CableModel<D>, const D: usize>(
             error,
             partial: Some(run),
         })),
+    }
+}
+
+/// Why the loop cannot be run with `opts` at all: a shaper still to be resolved, or the
+/// implicit integrator on a model without a second-order form.
+fn unsupported<M: CableModel<D>, const D: usize>(
+    sys: &ClosedLoop<M, D>,
+    opts: &RunOptions,
+) -> Option<RunError> {
+    if sys.shaper.is_none() {
+        Some(RunError::UnresolvedShaper)
+    } else if opts.integrator == IntegratorKind::Implicit && sys.model.second_order().is_none() {
+        Some(RunError::Unsupported {
+            integrator: IntegratorKind::Implicit.name(),
+            model: sys.model.name(),
+            why: "the model offers no second-order form",
+        })
+    } else {
+        None
     }
 }
 

@@ -1,11 +1,11 @@
 //! Sampling the dense output on the exact grid t_k = k·Δt, with the energy balance of each
 //! sample.
 
-use super::RunError;
 use super::events::check_slack;
+use super::{RunError, RunOptions, channel_names};
 use crate::closed_loop::ClosedLoop;
 use crate::model::CableModel;
-use crate::series::TimeSeries;
+use crate::series::{SeriesBuffer, TimeSeries};
 use cdpr_numerics::Stepper;
 
 /// Samples the dense output on the grid t_k = k·Δt (computed, not accumulated, so the grid is
@@ -28,6 +28,36 @@ pub(super) struct Sampler {
 }
 
 impl Sampler {
+    /// A sampler for `opts`' grid of the loop started from `y0`, its series in `buffer`'s
+    /// memory.
+    pub(super) fn new<M: CableModel<D>, const D: usize>(
+        sys: &ClosedLoop<M, D>,
+        y0: &[f64],
+        opts: &RunOptions,
+        buffer: SeriesBuffer,
+    ) -> Self {
+        let n = sys.model_len();
+        let names = channel_names(&sys.model);
+        let samples = (opts.t_final / opts.sample_period).round() as usize + 1;
+        Self {
+            series: TimeSeries::with_buffer(names, samples, buffer),
+            y: vec![0.0; y0.len()],
+            model_channels: sys.model.channel_names().len(),
+            l0_channels: (1..=sys.model.cables())
+                .filter_map(|i| {
+                    let name = format!("l0_{i}");
+                    sys.model.channel_names().iter().position(|c| *c == name)
+                })
+                .collect(),
+            energy0: sys.model.energy(&y0[..n]).total(),
+            event_energy: 0.0,
+            next: 0,
+            samples,
+            period: opts.sample_period,
+            t_final: opts.t_final,
+        }
+    }
+
     /// Appends every grid sample with t_k ≤ `t` (within the last accepted step).
     pub(super) fn sample_through<M: CableModel<D>, const D: usize>(
         &mut self,
