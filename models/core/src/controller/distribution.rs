@@ -78,8 +78,17 @@ impl TensionLimits {
     /// The commanded tensions clamped to the limits, and whether any was clamped.
     #[inline]
     pub fn clamp(&self, tensions: &Tensions) -> (Tensions, bool) {
-        let clamped = tensions.map(|t| t.clamp(self.t_min, self.t_max));
-        (clamped, clamped != *tensions)
+        // Compared cable by cable as each is clamped (a NaN counts as clamped): comparing the
+        // whole inline array afterwards reads it back in wide loads just after its narrow
+        // stores, a store-forwarding stall that was a fifth of the planar RHS.
+        let mut clamped = *tensions;
+        let mut saturated = false;
+        for t in clamped.iter_mut() {
+            let c = t.clamp(self.t_min, self.t_max);
+            saturated |= c != *t;
+            *t = c;
+        }
+        (clamped, saturated)
     }
 
     /// How far the farthest tension lies outside the limits [N] (≤ 0: all inside).
