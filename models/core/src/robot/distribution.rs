@@ -16,6 +16,7 @@
 
 use super::StructureMatrix;
 use super::cables::{CableId, MAX_CABLES, Tensions};
+use super::gram::gram_inverse;
 use super::space::{Matrix, Vector};
 
 /// A tension distribution method (`[controller] distribution`).
@@ -217,21 +218,6 @@ fn full_gram_inverse<const D: usize>(
 ) -> Result<Matrix<D>, DistributionError> {
     let all = [true; MAX_CABLES];
     gram_inverse(w, &all[..w.columns().len()]).ok_or(DistributionError::RankDeficient { axes: D })
-}
-
-/// Σ_{i free} u_i u_iᵀ, inverted; None when the free cables span fewer than D directions.
-fn gram_inverse<const D: usize>(w: &StructureMatrix<D>, free: &[bool]) -> Option<Matrix<D>> {
-    let mut g = Matrix::<D>::zeros();
-    for (u, _) in w.columns().iter().zip(free).filter(|(_, f)| **f) {
-        g += u * u.transpose();
-    }
-    // Rank test: every Cholesky pivot above 1e-12 of the trace (unit columns: the free count).
-    let floor = 1e-12 * g.trace().max(1.0);
-    let cholesky = g.cholesky()?;
-    if cholesky.l_dirty().diagonal().iter().any(|d| d * d <= floor) {
-        return None;
-    }
-    Some(cholesky.inverse())
 }
 
 /// The closed form on the free cables: T_i = T_m − u_iᵀ λ with (W_F W_Fᵀ) λ = W_F T_m − w

@@ -24,6 +24,7 @@
 
 pub mod cables;
 pub mod distribution;
+mod gram;
 pub mod space;
 
 pub use cables::{CableId, MAX_CABLES, PerCable, Tensions};
