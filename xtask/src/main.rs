@@ -11,6 +11,7 @@
 //! Errors are printed for a person and give a non-zero exit; a failed run keeps its output.
 
 mod control;
+mod csv_stream;
 mod distribution;
 mod figures;
 mod heatmap;

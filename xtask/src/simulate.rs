@@ -8,7 +8,8 @@
 //! always ends with a `metrics.json` that says whether it completed, failed or was interrupted,
 //! and where it came from.
 
-use crate::output::{Progress, csv_row, write_json};
+pub(crate) use crate::csv_stream::CsvStream;
+use crate::output::{Progress, write_json};
 use anyhow::{Context, Result, bail};
 use cdpr_bench::analysis::metrics::{Metrics, UNITS};
 use cdpr_bench::core::channel::heading;
@@ -19,8 +20,7 @@ use cdpr_bench::{Assessed, EndAnalysis, Error, ModelConfig, ModelKind, Provenanc
 use cdpr_sweep::DirLock;
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Set by SIGINT/SIGTERM, or by a failed write of the samples: the run stops after its current
@@ -148,78 +148,6 @@ pub(crate) fn check_memory(scenario: &Scenario) -> Result<()> {
         );
     }
     Ok(())
-}
-
-/// The time series written as the run samples it, every `every`-th row. A failed write stops
-/// the run ([`STOP`]) and is reported with the file's path.
-pub(crate) struct CsvStream {
-    writer: BufWriter<File>,
-    path: PathBuf,
-    every: usize,
-    rows: usize,
-    error: Option<std::io::Error>,
-}
-
-impl CsvStream {
-    pub(crate) fn create(path: PathBuf, headings: &[String], every: usize) -> Result<Self> {
-        let file = File::create(&path).with_context(|| format!("creating {}", path.display()))?;
-        let mut writer = BufWriter::with_capacity(1 << 16, file);
-        writeln!(writer, "{}", headings.join(","))
-            .with_context(|| format!("writing {}", path.display()))?;
-        Ok(Self {
-            writer,
-            path,
-            every,
-            rows: 0,
-            error: None,
-        })
-    }
-
-    pub(crate) fn push(&mut self, row: &[f64]) {
-        if self.rows.is_multiple_of(self.every) && self.error.is_none() {
-            let mut line = String::with_capacity(24 * row.len());
-            csv_row(&mut line, row);
-            if let Err(e) = self.writer.write_all(line.as_bytes()) {
-                self.error = Some(e);
-                STOP.store(true, Ordering::Relaxed);
-            }
-        }
-        self.rows += 1;
-    }
-
-    /// The write error, as the run's reason.
-    pub(crate) fn failure(&self) -> Option<String> {
-        self.error
-            .as_ref()
-            .map(|e| format!("writing {}: {e}", self.path.display()))
-    }
-
-    /// Writes the rows the stream has not seen (those of a failing step), then renames the file
-    /// into `target`. After a failed write the partial file stays as it is.
-    pub(crate) fn finish(
-        mut self,
-        series: &cdpr_bench::core::series::TimeSeries,
-        target: &Path,
-    ) -> Result<()> {
-        let mut row = vec![0.0; series.width()];
-        for i in self.rows..series.len() {
-            series.copy_row(i, &mut row);
-            self.push(&row);
-        }
-        if let Some(e) = self.failure() {
-            bail!("{e}");
-        }
-        let path = self.path.clone();
-        let file = self
-            .writer
-            .into_inner()
-            .map_err(|e| e.into_error())
-            .and_then(|f| f.sync_all().map(|_| f))
-            .with_context(|| format!("writing {}", path.display()))?;
-        drop(file);
-        std::fs::rename(&path, target)
-            .with_context(|| format!("renaming into {}", target.display()))
-    }
 }
 
 /// `run` watched by a progress bar labelled `label`, each sample written to `stream`, stopped
