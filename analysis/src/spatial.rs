@@ -72,26 +72,20 @@ impl SpatialMetrics {
     pub fn from_run(run: &Run, context: &SpatialContext) -> Self {
         let s = &run.series;
         let column = |c: Channel| s.channel(c).unwrap_or(&[]);
-        let (t, x, y, z) = (
-            column(Channel::Time),
-            column(Channel::X),
-            column(Channel::Y),
-            column(Channel::Z),
-        );
+        let t = column(Channel::Time);
         let x_ref = column(Channel::XRef);
         let m = run.equilibrium.tensions.len();
-        let start = Vector::<3>::new(
-            x.first().copied().unwrap_or(f64::NAN),
-            y.first().copied().unwrap_or(f64::NAN),
-            z.first().copied().unwrap_or(f64::NAN),
-        );
-        let error: Vec<f64> = (0..t.len())
-            .map(|i| {
+        let start = positions(run)
+            .next()
+            .map_or(Vector::<3>::repeat(f64::NAN), |(_, p)| p);
+        let error: Vec<f64> = positions(run)
+            .enumerate()
+            .map(|(i, (ti, p))| {
                 let reference = match &context.path {
-                    Some(path) => path.shaped(context.shaper.as_ref(), t[i], false)[0],
+                    Some(path) => path.shaped(context.shaper.as_ref(), ti, false)[0],
                     None => Vector::<3>::new(x_ref[i], start[1], start[2]),
                 };
-                (reference - Vector::<3>::new(x[i], y[i], z[i])).norm()
+                (reference - p).norm()
             })
             .collect();
         let window_max = |from: f64, to: f64| {
@@ -161,4 +155,17 @@ fn max_rate(t: &[f64], v: &[f64]) -> f64 {
             ((v[b] - v[a]) / (t[b] - t[a])).abs()
         })
         .fold(0.0, f64::max)
+}
+
+/// A spatial run's samples: time [s] and effector position [m].
+pub fn positions(run: &Run) -> impl Iterator<Item = (f64, Vector<3>)> + '_ {
+    let s = &run.series;
+    let column = |c: Channel| s.channel(c).unwrap_or(&[]);
+    let (t, x, y, z) = (
+        column(Channel::Time),
+        column(Channel::X),
+        column(Channel::Y),
+        column(Channel::Z),
+    );
+    (0..t.len()).map(move |i| (t[i], Vector::<3>::new(x[i], y[i], z[i])))
 }

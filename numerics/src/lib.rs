@@ -41,6 +41,7 @@ pub mod newton;
 pub mod norms;
 pub mod ode;
 pub mod riccati;
+pub mod small_cholesky;
 pub mod sparse;
 
 pub use dopri5::{Dopri5, Dopri5Options};

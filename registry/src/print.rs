@@ -6,9 +6,9 @@
 use crate::spatial::{check_feasible, loop_of, spatial_robot};
 use crate::study::Error;
 use cdpr_analysis::contour::ContourMetrics;
+pub use cdpr_analysis::spatial::positions;
 use cdpr_core::closed_loop::Path;
 use cdpr_core::print_path::{AxisShaper, PrintPath};
-use cdpr_core::robot::Vector;
 use cdpr_core::runner::{Observer, Run, RunOptions, simulate_observed_reusing};
 use cdpr_core::scenario::{Designed, Printer, Scenario, out_of_range};
 use cdpr_core::series::SeriesBuffer;
@@ -100,20 +100,6 @@ pub fn gcode_home(scenario: &Scenario) -> [f64; 3] {
         .as_deref()
         .map_or([0.0; 3], |s| [s[0], s[1], s[2]]);
     [0, 1, 2].map(|k| (start[k] - origin[k]) * 1e3)
-}
-
-/// The run's samples: time [s] and effector position [m].
-pub fn positions(run: &Run) -> impl Iterator<Item = (f64, Vector<3>)> + '_ {
-    use cdpr_core::channel::Channel;
-    let s = &run.series;
-    let column = |c: Channel| s.channel(c).unwrap_or(&[]);
-    let (t, x, y, z) = (
-        column(Channel::Time),
-        column(Channel::X),
-        column(Channel::Y),
-        column(Channel::Z),
-    );
-    (0..t.len()).map(move |i| (t[i], Vector::<3>::new(x[i], y[i], z[i])))
 }
 
 /// The firmware's shaper of each axis (None when `[printer] shaper = "none"`).

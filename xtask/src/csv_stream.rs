@@ -11,13 +11,14 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
-use std::sync::mpsc::{SyncSender, sync_channel};
+use std::sync::mpsc::{Receiver, SyncSender, channel, sync_channel};
 use std::thread::JoinHandle;
 
 /// Numbers per batch handed to the writer (128 KiB; ~800 rows of the paper's 20 channels).
 const BATCH: usize = 16 * 1024;
 
-/// Batches in flight: the integration waits for the writer beyond this (memory stays bounded).
+/// Batches in flight: the integration waits for the writer beyond this (memory stays bounded;
+/// the writer hands each written batch back, so at most this many plus two are ever allocated).
 const IN_FLIGHT: usize = 4;
 
 /// What the writer thread hands back: the file and the error that stopped its writing.
@@ -38,6 +39,10 @@ enum Sink {
 pub(crate) struct CsvStream {
     sink: Sink,
     batch: Vec<f64>,
+    /// Batches the writer has written, emptied, for reuse.
+    spare: Option<Receiver<Vec<f64>>>,
+    /// The text of one row, for rows written directly.
+    line: String,
     width: usize,
     path: PathBuf,
     every: usize,
@@ -54,12 +59,13 @@ impl CsvStream {
             .with_context(|| format!("writing {}", path.display()))?;
         let width = headings.len();
         let (batches, received) = sync_channel::<Vec<f64>>(IN_FLIGHT);
+        let (give_back, spare) = channel::<Vec<f64>>();
         let writer = std::thread::Builder::new()
             .name("csv writer".into())
             .spawn(move || {
                 let mut error = None;
                 let mut line = String::with_capacity(24 * width);
-                for batch in received {
+                for mut batch in received {
                     for row in batch.chunks_exact(width.max(1)) {
                         if error.is_some() {
                             break;
@@ -71,6 +77,9 @@ impl CsvStream {
                             STOP.store(true, Ordering::Relaxed);
                         }
                     }
+                    batch.clear();
+                    // The stream may have stopped listening (it settled): nothing to reuse.
+                    let _ = give_back.send(batch);
                 }
                 (writer, error)
             })
@@ -78,6 +87,8 @@ impl CsvStream {
         Ok(Self {
             sink: Sink::Thread { batches, writer },
             batch: Vec::with_capacity(BATCH + width),
+            spare: Some(spare),
+            line: String::with_capacity(24 * width),
             width,
             path,
             every,
@@ -97,17 +108,19 @@ impl CsvStream {
                 Sink::Thread { batches, .. } => {
                     self.batch.extend_from_slice(row);
                     if self.batch.len() >= BATCH {
-                        let full = std::mem::replace(
-                            &mut self.batch,
-                            Vec::with_capacity(BATCH + self.width),
-                        );
+                        let next = self
+                            .spare
+                            .as_ref()
+                            .and_then(|s| s.try_recv().ok())
+                            .unwrap_or_else(|| Vec::with_capacity(BATCH + self.width));
+                        let full = std::mem::replace(&mut self.batch, next);
                         writer_ended = batches.send(full).is_err();
                     }
                 }
                 Sink::Direct(writer) => {
-                    let mut line = String::with_capacity(24 * row.len());
-                    csv_row(&mut line, row);
-                    if let Err(e) = writer.write_all(line.as_bytes()) {
+                    self.line.clear();
+                    csv_row(&mut self.line, row);
+                    if let Err(e) = writer.write_all(self.line.as_bytes()) {
                         self.error = Some(e);
                         STOP.store(true, Ordering::Relaxed);
                     }
@@ -134,6 +147,7 @@ impl CsvStream {
             let _ = batches.send(std::mem::take(&mut self.batch));
         }
         drop(batches);
+        self.spare = None;
         match writer.join() {
             Ok((file, error)) => {
                 self.error = self.error.take().or(error);

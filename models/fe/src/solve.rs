@@ -13,6 +13,8 @@
 //! S⁻¹(F_border − Cᵀu), r'' = u − Y l''. Why not a dense or banded solve: B is the same tridiagonal
 //! matrix for x and z, and the border is at most 4 wide, so this is ~30 flops per node.
 
+use cdpr_numerics::small_cholesky;
+
 /// Largest border (l1, ρ1, l2, ρ2 for the elastic stored cable; l1, l2 for the rigid one).
 pub const MAX_BORDER: usize = 4;
 
@@ -135,30 +137,15 @@ impl ChainSystem {
 
 /// Solves the SPD system `a x = b` of size `n` ≤ 4 in place (`b` ← x) by Cholesky; false if `a` is
 /// not positive definite.
-// Triangular algorithms read as index arithmetic; iterator chains would hide the L_ij pattern.
+// Triangular substitutions read as index arithmetic; iterator chains would hide the L_ij pattern.
 #[allow(clippy::needless_range_loop)]
 fn cholesky_solve(
     a: &mut [[f64; MAX_BORDER]; MAX_BORDER],
     b: &mut [f64; MAX_BORDER],
     n: usize,
 ) -> bool {
-    for j in 0..n {
-        let mut d = a[j][j];
-        for k in 0..j {
-            d -= a[j][k] * a[j][k];
-        }
-        if d <= 0.0 || d.is_nan() {
-            return false;
-        }
-        let d = d.sqrt();
-        a[j][j] = d;
-        for i in j + 1..n {
-            let mut v = a[i][j];
-            for k in 0..j {
-                v -= a[i][k] * a[j][k];
-            }
-            a[i][j] = v / d;
-        }
+    if !small_cholesky::factor(a, n, 0.0) {
+        return false;
     }
     for i in 0..n {
         let mut v = b[i];

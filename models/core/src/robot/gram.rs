@@ -2,6 +2,7 @@
 //! distributions solve with (one per call at D ≤ 3, so its cost is a share of a spatial RHS).
 
 use super::{Matrix, StructureMatrix};
+use cdpr_numerics::small_cholesky;
 
 /// Σ_{i free} u_i u_iᵀ, inverted; None when the free cables span fewer than D directions.
 pub(super) fn gram_inverse<const D: usize>(
@@ -17,28 +18,13 @@ pub(super) fn gram_inverse<const D: usize>(
     spd_inverse(&g, floor)
 }
 
-/// G⁻¹ = L⁻ᵀ L⁻¹ of a symmetric D × D matrix by its Cholesky factor G = L Lᵀ, written out on
-/// fixed arrays (a general factorisation's column views cost more than the arithmetic at
-/// D ≤ 3, a quarter of a spatial RHS). None when a pivot l_jj² is at most `floor`.
+/// G⁻¹ = L⁻ᵀ L⁻¹ of a symmetric D × D matrix by its Cholesky factor G = L Lᵀ, on fixed arrays (a
+/// general factorisation's column views cost more than the arithmetic at D ≤ 3, a quarter of a
+/// spatial RHS). None when a pivot l_jj² is at most `floor`.
 fn spd_inverse<const D: usize>(g: &Matrix<D>, floor: f64) -> Option<Matrix<D>> {
-    let mut l = [[0.0; D]; D];
-    for j in 0..D {
-        let mut pivot = g[(j, j)];
-        for v in &l[j][..j] {
-            pivot -= v * v;
-        }
-        if pivot.is_nan() || pivot <= floor {
-            return None;
-        }
-        let root = pivot.sqrt();
-        l[j][j] = root;
-        for i in j + 1..D {
-            let mut v = g[(i, j)];
-            for (a, b) in l[i][..j].iter().zip(&l[j][..j]) {
-                v -= a * b;
-            }
-            l[i][j] = v / root;
-        }
+    let mut l: [[f64; D]; D] = std::array::from_fn(|i| std::array::from_fn(|j| g[(i, j)]));
+    if !small_cholesky::factor(&mut l, D, floor) {
+        return None;
     }
     // L⁻¹, lower triangular, column by column.
     let mut l_inv = [[0.0; D]; D];
