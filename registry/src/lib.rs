@@ -60,7 +60,7 @@ pub use provenance::{Provenance, project_revision, revision};
 pub use spatial::{
     FEASIBILITY_SAMPLES, InfeasibleReference, SpatialRun, check_feasible, check_reference,
     prepare_spatial, prepare_spatial_start, simulate_spatial, simulate_spatial_into,
-    spatial_channels, spatial_metrics, spatial_metrics_of, spatial_robot,
+    spatial_channel_headings, spatial_channels, spatial_metrics, spatial_metrics_of, spatial_robot,
 };
 pub use study::{
     Assessed, EndAnalysis, Error, analyse, assess, assess_observed, assess_observed_into,

@@ -20,6 +20,7 @@ use cdpr_core::series::SeriesBuffer;
 use cdpr_core::shaper::Impulses;
 use cdpr_core::trajectory::Segment;
 use cdpr_elastic::Elastic;
+use cdpr_lumped::spatial::LumpedSpatial;
 
 /// Instants of the reference checked for feasibility over the move (plus its start and end).
 pub const FEASIBILITY_SAMPLES: usize = 2000;
@@ -53,7 +54,7 @@ pub struct SpatialRun {
 /// The spatial robot's move, shaper and tension box, checked: the robot and its model
 /// ([`spatial_robot`]), the move given for three or more cables, the reference feasible.
 pub fn prepare_spatial(scenario: &Scenario) -> Result<Robot<3>, Error> {
-    let robot = spatial_robot(scenario)?;
+    let (robot, _) = run_robot(scenario)?;
     if robot.cables() >= 3 {
         let path = segment(scenario)?;
         let shaper = scenario.trajectory.impulses()?;
@@ -62,9 +63,27 @@ pub fn prepare_spatial(scenario: &Scenario) -> Result<Robot<3>, Error> {
     Ok(robot)
 }
 
-/// The scenario's spatial robot with its model checked (elastic: the massive cables run on the
-/// plane's robot only, so far) — what a statics or modes study needs, without the move.
+/// The scenario's spatial robot with its model checked, for the studies and the printing path,
+/// which run the massless elastic cables (a massive model is refused by name) — what a statics
+/// or modes study needs, without the move.
 pub fn spatial_robot(scenario: &Scenario) -> Result<Robot<3>, Error> {
+    let (robot, kind) = run_robot(scenario)?;
+    if kind != ModelKind::Elastic {
+        return Err(out_of_range(
+            "model.kind",
+            format!("\"{kind}\" with robot.anchors"),
+            "\"elastic\" for this study or print (the lumped cables in space run `simulate` \
+             moves so far)",
+        )
+        .into());
+    }
+    Ok(robot)
+}
+
+/// The scenario's spatial robot and the cable model its move runs, checked: the massless elastic
+/// cables, or the lumped ones (MODELS.md §4 in space) under a tension controller on DOPRI5 —
+/// the length reels, the implicit path and printing on lumped cables are refused by name.
+fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Error> {
     let robot = scenario.spatial_robot().ok_or_else(|| {
         out_of_range(
             "robot.anchors",
@@ -72,18 +91,69 @@ pub fn spatial_robot(scenario: &Scenario) -> Result<Robot<3>, Error> {
             "[[x, y, z], …] for a spatial run (the planar robot runs `simulate`)",
         )
     })?;
-    let kind = ModelConfig::from_scenario(scenario)?.kind;
-    if kind != ModelKind::Elastic {
-        return Err(out_of_range(
-            "model.kind",
-            format!("\"{kind}\" with robot.anchors"),
-            "\"elastic\": a spatial robot runs the massless elastic cables (the massive \
-             cables are planar so far)",
-        )
-        .into());
+    let config = ModelConfig::from_scenario(scenario)?;
+    match config.kind {
+        ModelKind::Elastic => cdpr_elastic::Params {}.validate(scenario)?,
+        ModelKind::Lumped => check_lumped(scenario, &robot)?,
+        ModelKind::Fe => {
+            return Err(out_of_range(
+                "model.kind",
+                "\"fe\" with robot.anchors",
+                "\"elastic\" or \"lumped\": the FE cables are planar so far",
+            )
+            .into());
+        }
     }
-    cdpr_elastic::Params {}.validate(scenario)?;
-    Ok(robot)
+    if config.kind == ModelKind::Lumped {
+        lumped_model(scenario, &config)?;
+    }
+    Ok((robot, config.kind))
+}
+
+/// What the spatial lumped cables run so far: three or more cables, tension reels, DOPRI5, a
+/// move (not a print).
+fn check_lumped(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
+    use cdpr_core::scenario::{ControllerKind, IntegratorKind};
+    let refuse = |key: &'static str, value: String, allowed: &str| -> Result<(), Error> {
+        Err(out_of_range(key, value, allowed.to_owned()).into())
+    };
+    if robot.cables() < 3 {
+        return refuse(
+            "robot.anchors",
+            format!("{} anchors with model.kind = \"lumped\"", robot.cables()),
+            "3 to 8 anchors for the spatial lumped cables (two cables in space run elastic)",
+        );
+    }
+    if scenario.controller.kind == ControllerKind::Length {
+        return refuse(
+            "controller.kind",
+            "\"length\" with model.kind = \"lumped\"".into(),
+            "a tension controller: reels driven by length on massive cables are not built yet",
+        );
+    }
+    if scenario.simulation.integrator != IntegratorKind::Dopri5 {
+        return refuse(
+            "simulation.integrator",
+            format!("\"{}\"", scenario.simulation.integrator.name()),
+            "\"dopri5\" for the spatial lumped cables (their implicit form is not built yet)",
+        );
+    }
+    if scenario.printer.is_some() {
+        return refuse(
+            "printer",
+            "a print with model.kind = \"lumped\"".into(),
+            "absent: prints run the elastic cables so far",
+        );
+    }
+    Ok(())
+}
+
+/// The spatial lumped model of `scenario` (its `[model] elements`).
+fn lumped_model(scenario: &Scenario, config: &ModelConfig) -> Result<LumpedSpatial, Error> {
+    Ok(LumpedSpatial::from_scenario(
+        scenario,
+        config.lumped()?.elements,
+    )?)
 }
 
 /// The scenario's move as a segment.
@@ -195,15 +265,30 @@ pub fn simulate_spatial_into(
     observer: &mut Observer,
     buffer: SeriesBuffer,
 ) -> Result<SpatialRun, Error> {
-    let mut sys = spatial_loop(scenario)?;
+    let robot = prepare_spatial(scenario)?;
+    if is_lumped(scenario)? {
+        let config = ModelConfig::from_scenario(scenario)?;
+        let sys = ClosedLoop::new(lumped_model(scenario, &config)?, scenario)?;
+        return run_loop(scenario, sys, observer, buffer);
+    }
+    run_loop(scenario, loop_of(scenario, robot)?, observer, buffer)
+}
+
+/// Runs the loop `sys` of `scenario` and measures it.
+fn run_loop<M: cdpr_core::model::CableModel<3>>(
+    scenario: &Scenario,
+    mut sys: ClosedLoop<M, 3>,
+    observer: &mut Observer,
+    buffer: SeriesBuffer,
+) -> Result<SpatialRun, Error> {
     let run = simulate_observed_reusing(&mut sys, &RunOptions::from(scenario), buffer, observer)?;
     let metrics = spatial_metrics(scenario, &sys, &run);
     Ok(SpatialRun { run, metrics })
 }
 
-/// The closed loop of a spatial scenario, checked whole by [`prepare_spatial`].
-fn spatial_loop(scenario: &Scenario) -> Result<ClosedLoop<Elastic<3>, 3>, Error> {
-    loop_of(scenario, prepare_spatial(scenario)?)
+/// Whether the scenario's spatial run is on lumped cables.
+fn is_lumped(scenario: &Scenario) -> Result<bool, Error> {
+    Ok(ModelConfig::from_scenario(scenario)?.kind == ModelKind::Lumped)
 }
 
 /// The closed loop of `robot` under `scenario`, the reference not checked again.
@@ -217,9 +302,11 @@ pub(crate) fn loop_of(
 
 /// The metrics of `run` (e.g. the part a failed run sampled) of the spatial `scenario`.
 pub fn spatial_metrics_of(scenario: &Scenario, run: &Run) -> Result<SpatialMetrics, Error> {
+    // The metrics read the loop's path, shaper and cable count, which the cable model does not
+    // change: the elastic loop of the same robot gives them.
     Ok(spatial_metrics(
         scenario,
-        &loop_of(scenario, spatial_robot(scenario)?)?,
+        &loop_of(scenario, run_robot(scenario)?.0)?,
         run,
     ))
 }
@@ -228,14 +315,35 @@ pub fn spatial_metrics_of(scenario: &Scenario, run: &Run) -> Result<SpatialMetri
 /// brought to rest at the start (a controller that cannot be designed, or a start the tensions
 /// do not hold, is refused here).
 pub fn prepare_spatial_start(scenario: &Scenario) -> Result<(), Error> {
-    spatial_loop(scenario)?.initial_state()?;
+    let robot = prepare_spatial(scenario)?;
+    if is_lumped(scenario)? {
+        let config = ModelConfig::from_scenario(scenario)?;
+        ClosedLoop::new(lumped_model(scenario, &config)?, scenario)?.initial_state()?;
+    } else {
+        loop_of(scenario, robot)?.initial_state()?;
+    }
     Ok(())
 }
 
 /// The number of channels of a spatial scenario's run.
 pub fn spatial_channels(scenario: &Scenario) -> Result<usize, Error> {
-    let model = Elastic::new(spatial_robot(scenario)?, scenario.cable.axial_stiffness());
-    Ok(cdpr_core::runner::channel_names(&model).len())
+    Ok(spatial_channel_headings(scenario)?.0.len())
+}
+
+/// The names and units of a spatial scenario's channels (its cable model's own after the common
+/// ones).
+pub fn spatial_channel_headings(
+    scenario: &Scenario,
+) -> Result<(Vec<String>, Vec<&'static str>), Error> {
+    use cdpr_core::runner::{channel_names, channel_units};
+    let (robot, kind) = run_robot(scenario)?;
+    Ok(if kind == ModelKind::Lumped {
+        let model = lumped_model(scenario, &ModelConfig::from_scenario(scenario)?)?;
+        (channel_names(&model), channel_units(&model))
+    } else {
+        let model = Elastic::new(robot, scenario.cable.axial_stiffness());
+        (channel_names(&model), channel_units(&model))
+    })
 }
 
 /// The metrics of a spatial run of `scenario` on the loop `sys`.

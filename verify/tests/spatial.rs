@@ -518,7 +518,16 @@ fn bad_spatial_input_is_refused_by_name() {
         "[trajectory]\nend = [0.3, 0.2, 0.2]\nt2 = 0.05",
         "wrench-feasible",
     );
-    refuse("[model]\nkind = \"lumped\"", "model.kind");
+    refuse("[model]\nkind = \"fe\"", "model.kind");
+    refuse("[model]\nkind = \"lumped\"", "cable.modelled_length");
+    refuse(
+        "[model]\nkind = \"lumped\"\nelements = 2\n[cable]\nmodelled_length = 3.2",
+        "model.elements",
+    );
+    refuse(
+        "[robot]\nreel_directions = [[0, 0, 1]]",
+        "robot.reel_directions",
+    );
     refuse(
         "[trajectory]\nshaper = \"zv\"",
         "trajectory.shaper_frequency",

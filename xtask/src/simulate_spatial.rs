@@ -12,7 +12,7 @@ use crate::simulate::{
 use anyhow::{Context, Result, bail};
 use cdpr_bench::analysis::spatial::SpatialMetrics;
 use cdpr_bench::core::channel::heading;
-use cdpr_bench::core::runner::{RunError, channel_names, channel_units};
+use cdpr_bench::core::runner::RunError;
 use cdpr_bench::core::scenario::Scenario;
 use cdpr_bench::{Error, Provenance, SpatialRun};
 use cdpr_sweep::DirLock;
@@ -41,22 +41,25 @@ pub fn run(scenario: &Scenario, out: &Path, every: usize) -> Result<()> {
     // What can be known before the run (the reference's feasibility, the start, the
     // controller's design): refused here, before anything is written.
     cdpr_bench::prepare(scenario)?;
-    let robot = cdpr_bench::spatial_robot(scenario)?;
+    let (names, units) = cdpr_bench::spatial_channel_headings(scenario)?;
     let provenance = Provenance::of(scenario)?;
     writable_out(out)?;
     let _lock = DirLock::acquire(out, "simulate")?;
     prepare_out(out)?;
-    let model = cdpr_bench::elastic::Elastic::new(robot, scenario.cable.axial_stiffness());
-    let headings: Vec<String> = channel_names(&model)
+    let headings: Vec<String> = names
         .iter()
-        .zip(channel_units(&model))
+        .zip(units)
         .map(|(name, unit)| heading(name, unit))
         .collect();
     check_memory(scenario)?;
     ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed))
         .context("installing the SIGINT/SIGTERM handler")?;
     let mut stream = CsvStream::create(out.join(PARTIAL), &headings, every)?;
-    let result = streamed(&mut stream, "elastic (space)", |observer| {
+    let label = format!(
+        "{} (space)",
+        cdpr_bench::ModelConfig::from_scenario(scenario)?.kind
+    );
+    let result = streamed(&mut stream, &label, |observer| {
         cdpr_bench::simulate_spatial(scenario, observer)
     });
     let Ending {
@@ -163,11 +166,13 @@ fn write_metrics(
 /// The run's summary on stdout.
 fn summary(d: &SpatialRun, out: &Path) {
     println!(
-        "elastic in space, {} cables: {} samples, {} RHS evaluations, {} accepted steps; path error during the move {:.3e} m, 1 s after {:.3e} m → {}",
+        "{} in space, {} cables: {} samples, {} RHS evaluations, {} accepted steps, {} pulley events; path error during the move {:.3e} m, 1 s after {:.3e} m → {}",
+        d.run.model,
         d.metrics.cables,
         d.run.series.len(),
         d.run.stats.rhs_evals,
         d.run.stats.steps_accepted,
+        d.run.events.len(),
         d.metrics.path_err_max_move,
         d.metrics.path_err_max_after_1s,
         out.display()

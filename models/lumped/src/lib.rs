@@ -19,6 +19,7 @@ mod implicit;
 mod modal;
 pub mod params;
 mod pulley;
+pub mod spatial;
 mod statics;
 
 use cdpr_core::model::{CableModel, Energy, Equilibrium, ModelError, ModelEvent, RestRule};

@@ -34,6 +34,11 @@ pub struct Robot {
     /// its pulley, z up; 2 ≤ m ≤ 8). Absent: the planar robot of `anchor_distance`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub anchors: Option<Vec<Vec<f64>>>,
+    /// A spatial robot's reel directions r_i [[x, y, z], …], one per anchor: the line behind each
+    /// pulley along which a massive cable's stored part lies (MODELS.md §11). Absent: horizontal,
+    /// away from the anchors' centroid.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reel_directions: Option<Vec<Vec<f64>>>,
 }
 
 impl Robot {
@@ -84,6 +89,7 @@ impl Default for Robot {
             effector_mass: 1.0,
             gravity: 9.81,
             anchors: None,
+            reel_directions: None,
         }
     }
 }

@@ -9,6 +9,7 @@ impl Scenario {
     /// A spatial robot: anchors, mass, cable, box, controller, move and integration.
     pub(super) fn validate_spatial(&self) -> Result<(), ScenarioError> {
         let anchors = self.validate_anchors()?;
+        self.validate_reel_directions(anchors.len())?;
         positive("robot.effector_mass", self.robot.effector_mass)?;
         positive("robot.gravity", self.robot.gravity)?;
         self.validate_cable()?;
@@ -71,6 +72,32 @@ impl Scenario {
             ));
         }
         Ok(points)
+    }
+
+    /// One reel direction of three finite coordinates, not zero, per anchor (whether each
+    /// leaves the workspace is the massive model's check, which knows the robot).
+    fn validate_reel_directions(&self, m: usize) -> Result<(), ScenarioError> {
+        let Some(reels) = &self.robot.reel_directions else {
+            return Ok(());
+        };
+        if reels.len() != m {
+            return Err(out_of_range(
+                "robot.reel_directions",
+                format!("{} directions", reels.len()),
+                format!("one per anchor ({m})"),
+            ));
+        }
+        for (i, r) in reels.iter().enumerate() {
+            let finite = r.len() == 3 && r.iter().all(|v| v.is_finite());
+            if !finite || r.iter().all(|v| *v == 0.0) {
+                return Err(out_of_range(
+                    "robot.reel_directions",
+                    format!("direction {} = {r:?}", i + 1),
+                    "three finite coordinates [x, y, z], not all zero",
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// The box [t_min, t_max] every distribution keeps the tensions in.

@@ -25,6 +25,14 @@ impl Scenario {
                  [robot] anchors",
             ));
         }
+        if let Some(reels) = &self.robot.reel_directions {
+            return Err(out_of_range(
+                "robot.reel_directions",
+                format!("{reels:?}"),
+                "absent for the planar robot (its reels lie along ∓x, MODELS.md §4); a spatial \
+                 robot gives [robot] anchors",
+            ));
+        }
         self.validate_robot_and_cable()?;
         if self.controller.kind == ControllerKind::Length {
             return Err(out_of_range(

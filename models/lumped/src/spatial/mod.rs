@@ -1,0 +1,581 @@
+//! # The lumped cable in space (MODELS.md §4 along each cable's own path, §11)
+//!
+//! Every cable i of a spatial robot is the planar model's chain: N point masses P_0 … P_{N−1}
+//! (m = μ l0 each, l0 = L0/N) joined by N tension-only springs of stiffness k0 = EA/l0, spring j
+//! from P_j to P_{j+1}, P_N the effector shared by all m cables. The pulley is the anchor A_i;
+//! behind it the stored nodes slide on the reel line A_i + s r_i (r_i the cable's unit reel
+//! direction, pointing away from the workspace), the 3-D form of eq. 6: their acceleration is
+//! the component along r_i of their net force (gravity included), the guide reacting the rest.
+//! Free nodes move in space under gravity (eq. 7). The straddling spring runs over the pulley
+//! (eq. 4): λ = |P_{r−1} A_i| + |A_i P_r|. The commanded tension pulls P_0 along r_i. Nodes pass
+//! the pulley as located events ([`pulley`]), each keeping its mass: the cable mass is
+//! conserved exactly.
+//!
+//! With two cables whose anchors and reel lines lie in the x–z plane this is the planar model
+//! [`crate::Lumped`] in a third coordinate that stays zero; the tests check the two against each
+//! other.
+//!
+//! State: per cable the x, y and z of nodes 0 … N−1 (each axis contiguous, so that the spring
+//! sweep vectorises), then the effector's (x, y, z): 3mN + 3 positions, then the velocities in
+//! the same order. The stored-node counts r_i are the model's discrete mode.
+
+mod pulley;
+mod statics;
+
+use crate::spring_tension;
+use cdpr_core::modal_layout::{Dof, ModalLayout};
+use cdpr_core::model::{CableModel, Energy, Equilibrium, ModelError, ModelEvent, RestRule};
+use cdpr_core::robot::{Effector, MAX_CABLES, PerCable, Robot};
+use cdpr_core::scenario::Scenario;
+use nalgebra::Vector3;
+
+pub use statics::{Hang, hang};
+
+/// The scenario's cable as the spatial lumped model needs it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CableProperties {
+    /// Springs per cable N.
+    pub elements: usize,
+    /// Modelled unstrained length per cable L0 [m].
+    pub modelled_length: f64,
+    /// Mass per unstrained length μ [kg/m].
+    pub mass_per_length: f64,
+    /// Axial stiffness EA [N].
+    pub axial_stiffness: f64,
+    /// Kelvin–Voigt coefficient C [N s] (0: undamped).
+    pub axial_damping: f64,
+}
+
+/// The spatial robot with lumped mass-spring cables.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LumpedSpatial {
+    robot: Robot<3>,
+    /// Springs per cable N.
+    pub elements: usize,
+    /// Unstrained spring length l0 = L0/N [m].
+    pub segment: f64,
+    /// Node mass m = μ l0 [kg].
+    pub node_mass: f64,
+    /// Spring stiffness k0 = EA/l0 [N/m].
+    pub stiffness: f64,
+    /// Kelvin–Voigt coefficient per unit length rate, C/l0 [N s/m].
+    pub damping: f64,
+    /// Unit reel direction r_i of each cable.
+    reels: [Vector3<f64>; MAX_CABLES],
+    /// Stored nodes r_i of each cable (nodes 0 … r_i − 1 lie on the reel line).
+    stored: [usize; MAX_CABLES],
+    /// Per cable, the forces of its springs on their two end nodes (allocated once).
+    scratch: Vec<SpringForces>,
+}
+
+/// Forces of springs j = 0 … N−1 on their end nodes a = P_j and b = P_{j+1} [N], per axis.
+#[derive(Debug, Clone, PartialEq, Default)]
+struct SpringForces {
+    a: [Vec<f64>; 3],
+    b: [Vec<f64>; 3],
+}
+
+/// The default reel direction of each anchor (MODELS.md §11): horizontal, away from the anchors'
+/// centroid (+x for an anchor straight above or below it).
+pub fn default_reel_directions(anchors: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
+    let centroid = anchors.iter().sum::<Vector3<f64>>() / anchors.len() as f64;
+    anchors
+        .iter()
+        .map(|a| {
+            let away = Vector3::new(a.x - centroid.x, a.y - centroid.y, 0.0);
+            if away.norm() > 1e-9 {
+                away.normalize()
+            } else {
+                Vector3::x()
+            }
+        })
+        .collect()
+}
+
+impl LumpedSpatial {
+    /// The robot's cables lumped, reeled along `reels` (unit vectors, checked to point away from
+    /// the anchors' centroid, i.e. out of the workspace); r_i are set by the statics.
+    pub fn new(
+        robot: Robot<3>,
+        cable: CableProperties,
+        reels: &[Vector3<f64>],
+    ) -> Result<Self, ModelError> {
+        let n = cable.elements;
+        if n < crate::params::MIN_ELEMENTS {
+            return Err(ModelError::Parameter {
+                name: "model.elements",
+                value: n as f64,
+                allowed: "≥ 3 for the lumped model (a reel end, a straddling spring, a free node)"
+                    .into(),
+            });
+        }
+        let m = robot.cables();
+        let centroid = robot.anchors().iter().sum::<Vector3<f64>>() / m as f64;
+        let mut units = [Vector3::x(); MAX_CABLES];
+        for (i, r) in reels.iter().enumerate().take(m) {
+            let norm = r.norm();
+            let outward = (robot.anchor(i) - centroid).dot(r);
+            if !(norm.is_finite() && norm > 0.0 && outward > 0.0) {
+                return Err(ModelError::Parameter {
+                    name: "robot.reel_directions",
+                    value: outward,
+                    allowed: format!(
+                        "cable {}: a nonzero direction [{}, {}, {}] pointing away from the \
+                         anchors' centroid (its dot product with A_i − centroid > 0): the reel \
+                         line must leave the workspace",
+                        i + 1,
+                        r.x,
+                        r.y,
+                        r.z
+                    ),
+                });
+            }
+            units[i] = r / norm;
+        }
+        if reels.len() != m {
+            return Err(ModelError::Parameter {
+                name: "robot.reel_directions",
+                value: reels.len() as f64,
+                allowed: format!("one direction per anchor ({m})"),
+            });
+        }
+        let segment = cable.modelled_length / n as f64;
+        Ok(Self {
+            robot,
+            elements: n,
+            segment,
+            node_mass: cable.mass_per_length * segment,
+            stiffness: cable.axial_stiffness / segment,
+            damping: cable.axial_damping / segment,
+            reels: units,
+            stored: [n / 2; MAX_CABLES],
+            scratch: vec![
+                SpringForces {
+                    a: std::array::from_fn(|_| vec![0.0; n]),
+                    b: std::array::from_fn(|_| vec![0.0; n]),
+                };
+                m
+            ],
+        })
+    }
+
+    /// The scenario's spatial robot (`[robot] anchors`, `reel_directions`) with its cable lumped
+    /// into `elements` springs, the modelled length checked against the move: it must cover
+    /// 1.05 (1 + t_max/EA) times the longest chord from a pulley to the move's start or end, plus
+    /// two spare stored elements (MODELS.md §9's rule in space; the chord to a straight segment
+    /// is longest at one of its ends).
+    pub fn from_scenario(scenario: &Scenario, elements: usize) -> Result<Self, ModelError> {
+        let robot = scenario.spatial_robot().ok_or(ModelError::Parameter {
+            name: "robot.anchors",
+            value: f64::NAN,
+            allowed: "the anchors of a spatial robot".into(),
+        })?;
+        let reels: Vec<Vector3<f64>> = match &scenario.robot.reel_directions {
+            Some(given) => given
+                .iter()
+                .map(|r| Vector3::from_iterator(r.iter().copied()))
+                .collect(),
+            None => default_reel_directions(robot.anchors()),
+        };
+        let c = &scenario.cable;
+        let cable = CableProperties {
+            elements,
+            modelled_length: c.modelled_length,
+            mass_per_length: c.mass_per_length(),
+            axial_stiffness: c.axial_stiffness(),
+            axial_damping: c.axial_damping,
+        };
+        let model = Self::new(robot, cable, &reels)?;
+        if let Ok((start, end)) = scenario.trajectory.spatial_move() {
+            let chord = [start, end]
+                .iter()
+                .flat_map(|p| {
+                    let p = Vector3::from(*p);
+                    robot.anchors().iter().map(move |a| (a - p).norm())
+                })
+                .fold(0.0, f64::max);
+            let stretch = 1.0 + scenario.controller.t_max.unwrap_or(0.0) / cable.axial_stiffness;
+            let needed = 1.05 * stretch * chord + 2.0 * model.segment;
+            if cable.modelled_length < needed {
+                return Err(ModelError::Parameter {
+                    name: "cable.modelled_length",
+                    value: cable.modelled_length,
+                    allowed: format!(
+                        "≥ {needed:.6} m for this move (1.05 × (1 + t_max/EA) × longest chord \
+                         {chord:.6} m, plus two spare stored elements)"
+                    ),
+                });
+            }
+        }
+        Ok(model)
+    }
+
+    /// Stored nodes per cable, r_i.
+    pub fn stored(&self) -> &[usize] {
+        &self.stored[..self.robot.cables()]
+    }
+
+    /// Sets the stored-node counts (the discrete mode), e.g. for a hand-made state.
+    pub fn set_stored(&mut self, stored: &[usize]) {
+        self.stored[..stored.len()].copy_from_slice(stored);
+    }
+
+    /// The unit reel direction r_i of `cable`.
+    pub fn reel(&self, cable: usize) -> Vector3<f64> {
+        self.reels[cable]
+    }
+
+    /// Pulley point A_i [m].
+    pub fn pulley(&self, cable: usize) -> Vector3<f64> {
+        self.robot.anchor(cable)
+    }
+
+    /// Number of position coordinates, 3mN + 3.
+    pub fn positions_len(&self) -> usize {
+        3 * self.robot.cables() * self.elements + 3
+    }
+
+    /// Index of coordinate `axis` (0 x, 1 y, 2 z) of node `j` of `cable` (j = N: the effector).
+    #[inline]
+    pub fn index(&self, cable: usize, j: usize, axis: usize) -> usize {
+        let n = self.elements;
+        if j == n {
+            3 * self.robot.cables() * n + axis
+        } else {
+            (3 * cable + axis) * n + j
+        }
+    }
+
+    /// Position of node `j` of `cable` (the effector at j = N) [m].
+    #[inline]
+    pub fn node(&self, y: &[f64], cable: usize, j: usize) -> Vector3<f64> {
+        Vector3::from_fn(|axis, _| y[self.index(cable, j, axis)])
+    }
+
+    /// Velocity of node `j` of `cable` [m/s].
+    #[inline]
+    pub fn node_velocity(&self, y: &[f64], cable: usize, j: usize) -> Vector3<f64> {
+        let np = self.positions_len();
+        Vector3::from_fn(|axis, _| y[np + self.index(cable, j, axis)])
+    }
+
+    /// Length λ_j of spring j of `cable` along the cable path (eq. 4 over the pulley).
+    pub fn spring_length(&self, y: &[f64], cable: usize, j: usize) -> f64 {
+        let (a, b) = (self.node(y, cable, j), self.node(y, cable, j + 1));
+        if j + 1 == self.stored[cable] {
+            let pulley = self.pulley(cable);
+            (pulley - a).norm() + (pulley - b).norm()
+        } else {
+            (b - a).norm()
+        }
+    }
+
+    /// Length λ_j, rate λ̇_j and the unit vectors along which spring j pulls its end nodes (both
+    /// toward the pulley for the straddling spring, eq. 4).
+    #[inline]
+    fn spring(&self, y: &[f64], cable: usize, j: usize) -> (f64, f64, Vector3<f64>, Vector3<f64>) {
+        let (a, b) = (self.node(y, cable, j), self.node(y, cable, j + 1));
+        let (va, vb) = (
+            self.node_velocity(y, cable, j),
+            self.node_velocity(y, cable, j + 1),
+        );
+        if j + 1 == self.stored[cable] {
+            let pulley = self.pulley(cable);
+            let (da, db) = (pulley - a, pulley - b);
+            let (la, lb) = (da.norm(), db.norm());
+            // A node exactly at the pulley: the limit of the path's direction is the chord's.
+            let toward = |d: Vector3<f64>, l: f64, other: Vector3<f64>| {
+                if l > 0.0 { d / l } else { other.normalize() }
+            };
+            let (ua, ub) = (toward(da, la, b - a), toward(db, lb, a - b));
+            (la + lb, -ua.dot(&va) - ub.dot(&vb), ua, ub)
+        } else {
+            let d = b - a;
+            let l = d.norm();
+            let u = d / l;
+            (l, u.dot(&(vb - va)), u, -u)
+        }
+    }
+
+    /// Tension of spring j of `cable` [N].
+    pub fn spring_force(&self, y: &[f64], cable: usize, j: usize) -> f64 {
+        let (length, rate, _, _) = self.spring(y, cable, j);
+        spring_tension(self.stiffness, self.segment, self.damping, length, rate)
+    }
+
+    /// Unstrained length between the pulley and the effector [m]: the free springs and the
+    /// free-side share of the straddling spring.
+    pub fn free_length(&self, y: &[f64], cable: usize) -> f64 {
+        let r = self.stored[cable];
+        let free_springs = (self.elements - r) as f64 * self.segment;
+        if r == 0 {
+            return free_springs;
+        }
+        let length = self.spring_length(y, cable, r - 1);
+        let free_part = (self.pulley(cable) - self.node(y, cable, r)).norm();
+        free_springs + self.segment * free_part / length
+    }
+
+    /// Total mass of the cables [kg].
+    pub fn cable_mass(&self) -> f64 {
+        (self.robot.cables() * self.elements) as f64 * self.node_mass
+    }
+
+    /// Net force on every position coordinate [N]: springs, gravity, the reel tensions on P_0;
+    /// a stored node keeps the component along its reel line (the guide reacts the rest).
+    fn forces(&mut self, y: &[f64], tensions: &[f64], out: &mut [f64]) {
+        let n = self.elements;
+        let weight = self.node_mass * self.gravity();
+        let mut effector = Vector3::new(0.0, 0.0, -self.robot.effector_mass * self.gravity());
+        for cable in 0..self.robot.cables() {
+            let mut s = std::mem::take(&mut self.scratch[cable]);
+            self.chord_springs(y, cable, &mut s);
+            let r = self.stored[cable];
+            for j in [Some(n - 1), r.checked_sub(1)].into_iter().flatten() {
+                let (length, rate, ua, ub) = self.spring(y, cable, j);
+                let t = spring_tension(self.stiffness, self.segment, self.damping, length, rate);
+                for axis in 0..3 {
+                    s.a[axis][j] = t * ua[axis];
+                    s.b[axis][j] = t * ub[axis];
+                }
+            }
+            let reel = self.reels[cable];
+            for axis in 0..3 {
+                let f = &mut out[self.index(cable, 0, axis)..][..n];
+                let (a, b) = (&s.a[axis], &s.b[axis]);
+                f[0] = a[0] + tensions[cable] * reel[axis];
+                for ((f, a), b) in f[1..].iter_mut().zip(&a[1..]).zip(&b[..n - 1]) {
+                    *f = a + b;
+                }
+                effector[axis] += s.b[axis][n - 1];
+            }
+            let z = self.index(cable, 0, 2);
+            out[z..z + n].iter_mut().for_each(|f| *f -= weight);
+            for j in 0..r {
+                let f = self.node(out, cable, j);
+                let along = reel * f.dot(&reel);
+                for axis in 0..3 {
+                    out[self.index(cable, j, axis)] = along[axis];
+                }
+            }
+            self.scratch[cable] = s;
+        }
+        for axis in 0..3 {
+            out[self.index(0, n, axis)] = effector[axis];
+        }
+    }
+
+    /// The springs between two cable nodes (j = 0 … N − 2) as straight chords, one sweep per
+    /// cable over its contiguous coordinates.
+    fn chord_springs(&self, y: &[f64], cable: usize, s: &mut SpringForces) {
+        let n = self.elements;
+        let np = self.positions_len();
+        let (k, l0, c) = (self.stiffness, self.segment, self.damping);
+        let at = |axis: usize| &y[self.index(cable, 0, axis)..][..n];
+        let rate_of = |axis: usize| &y[np + self.index(cable, 0, axis)..][..n];
+        let (x, yy, z) = (at(0), at(1), at(2));
+        let (vx, vy, vz) = (rate_of(0), rate_of(1), rate_of(2));
+        let [ax, ay, az] = &mut s.a;
+        let [bx, by, bz] = &mut s.b;
+        for j in 0..n - 1 {
+            let (dx, dy, dz) = (x[j + 1] - x[j], yy[j + 1] - yy[j], z[j + 1] - z[j]);
+            let length = (dx * dx + dy * dy + dz * dz).sqrt();
+            let per_length = if c == 0.0 {
+                (k * (length - l0)).max(0.0) / length
+            } else {
+                let rate = (dx * (vx[j + 1] - vx[j])
+                    + dy * (vy[j + 1] - vy[j])
+                    + dz * (vz[j + 1] - vz[j]))
+                    / length;
+                spring_tension(k, l0, c, length, rate) / length
+            };
+            (ax[j], ay[j], az[j]) = (per_length * dx, per_length * dy, per_length * dz);
+            (bx[j], by[j], bz[j]) = (-ax[j], -ay[j], -az[j]);
+        }
+    }
+
+    fn gravity(&self) -> f64 {
+        self.robot.gravity
+    }
+}
+
+impl CableModel<3> for LumpedSpatial {
+    fn name(&self) -> &'static str {
+        "lumped"
+    }
+
+    fn robot(&self) -> &Robot<3> {
+        &self.robot
+    }
+
+    fn state_len(&self) -> usize {
+        2 * self.positions_len()
+    }
+
+    fn equilibrium(&mut self, rule: &dyn RestRule<3>) -> Result<Equilibrium, ModelError> {
+        statics::equilibrium(self, rule)
+    }
+
+    fn rhs(&mut self, _t: f64, y: &[f64], tensions: &[f64], rate: &mut [f64]) {
+        let n = self.elements;
+        let np = self.positions_len();
+        let (dq, dv) = rate.split_at_mut(np);
+        dq.copy_from_slice(&y[np..]);
+        self.forces(y, tensions, dv);
+        let inv_m = 1.0 / self.node_mass;
+        let cables = 3 * self.robot.cables() * n;
+        dv[..cables].iter_mut().for_each(|a| *a *= inv_m);
+        dv[cables..]
+            .iter_mut()
+            .for_each(|a| *a /= self.robot.effector_mass);
+        // Stored nodes move along their reel line only.
+        for cable in 0..self.robot.cables() {
+            let reel = self.reels[cable];
+            for j in 0..self.stored[cable] {
+                let v = self.node(dq, cable, j);
+                let along = reel * v.dot(&reel);
+                for axis in 0..3 {
+                    dq[self.index(cable, j, axis)] = along[axis];
+                }
+            }
+        }
+    }
+
+    fn effector(&self, y: &[f64]) -> Effector<3> {
+        Effector {
+            position: self.node(y, 0, self.elements),
+            velocity: self.node_velocity(y, 0, self.elements),
+        }
+    }
+
+    /// The reel end P_0 moving along r_i takes cable in.
+    fn reel_speeds(&self, y: &[f64]) -> PerCable {
+        PerCable::from_fn(self.robot.cables(), |c| {
+            self.node_velocity(y, c, 0).dot(&self.reels[c])
+        })
+    }
+
+    fn energy(&self, y: &[f64]) -> Energy {
+        let (m, g, l0, k) = (self.node_mass, self.gravity(), self.segment, self.stiffness);
+        let mut e = Energy::default();
+        for cable in 0..self.robot.cables() {
+            for j in 0..self.elements {
+                let (p, v) = (self.node(y, cable, j), self.node_velocity(y, cable, j));
+                e.kinetic += 0.5 * m * v.norm_squared();
+                e.gravity += m * g * p.z;
+                let stretch = (self.spring_length(y, cable, j) - l0).max(0.0);
+                e.elastic += 0.5 * k * stretch * stretch;
+            }
+        }
+        let effector = self.effector(y);
+        e.kinetic += 0.5 * self.robot.effector_mass * effector.velocity.norm_squared();
+        e.gravity += self.robot.effector_mass * g * effector.position.z;
+        e
+    }
+
+    /// Power of the damping forces: Σ (T − k0 (λ − l0)⁺) λ̇ ≥ 0.
+    fn dissipation(&self, y: &[f64]) -> f64 {
+        if self.damping == 0.0 {
+            return 0.0;
+        }
+        let mut d = 0.0;
+        for cable in 0..self.robot.cables() {
+            for j in 0..self.elements {
+                let (length, rate, _, _) = self.spring(y, cable, j);
+                let elastic = self.stiffness * (length - self.segment).max(0.0);
+                let t = spring_tension(self.stiffness, self.segment, self.damping, length, rate);
+                d += (t - elastic) * rate;
+            }
+        }
+        d
+    }
+
+    fn event_count(&self) -> usize {
+        pulley::PER_CABLE * self.robot.cables()
+    }
+
+    fn event_functions(&self, y: &[f64], out: &mut [f64]) {
+        pulley::event_functions(self, y, out);
+    }
+
+    fn apply_event(
+        &mut self,
+        index: usize,
+        t: f64,
+        y: &mut [f64],
+    ) -> Result<ModelEvent, ModelError> {
+        pulley::apply_event(self, index, t, y)
+    }
+
+    fn channel_names(&self) -> Vec<String> {
+        cdpr_core::channel::Channel::cable_channel_names(self.robot.cables())
+    }
+
+    fn channel_units(&self) -> Vec<&'static str> {
+        cdpr_core::channel::Channel::cable_channel_units(self.robot.cables(), "nodes")
+    }
+
+    /// Per kind, cable 1 … m: the spring tension at the effector and over the pulley [N], the
+    /// free unstrained length [m], the stored-node count.
+    fn channels(&self, y: &[f64], _tensions: &[f64], out: &mut [f64]) {
+        let m = self.robot.cables();
+        let n = self.elements;
+        for c in 0..m {
+            let r = self.stored[c];
+            out[c] = self.spring_force(y, c, n - 1);
+            out[m + c] = if r == 0 {
+                f64::NAN
+            } else {
+                self.spring_force(y, c, r - 1)
+            };
+            out[2 * m + c] = self.free_length(y, c);
+            out[3 * m + c] = r as f64;
+        }
+    }
+
+    /// The effector and each free node with its cable's tangent; a stored node moves material
+    /// along its reel line, listed as the coordinate on which r_i is largest with the other two
+    /// frozen — exact for reel lines along an axis (the spatial modes study runs the elastic
+    /// model; this layout serves a modal analysis of hand-built states).
+    fn modal_layout(&self, y: &[f64]) -> ModalLayout {
+        let n = self.elements;
+        let mut layout = ModalLayout {
+            dofs: vec![Dof::Effector {
+                coordinates: (0..3).map(|axis| self.index(0, n, axis)).collect(),
+                mass: self.robot.effector_mass,
+            }],
+            frozen: Vec::new(),
+        };
+        for cable in 0..self.robot.cables() {
+            let r = self.stored[cable];
+            let reel = self.reels[cable];
+            let along = reel.iamax();
+            for j in 0..n {
+                if j < r {
+                    for axis in (0..3).filter(|&a| a != along) {
+                        layout.frozen.push(self.index(cable, j, axis));
+                    }
+                    layout.dofs.push(Dof::Axial {
+                        cable,
+                        index: self.index(cable, j, along),
+                        mass: self.node_mass,
+                    });
+                } else {
+                    let prev = if j == r {
+                        self.pulley(cable)
+                    } else {
+                        self.node(y, cable, j - 1)
+                    };
+                    let tangent = (self.node(y, cable, j + 1) - prev).normalize();
+                    layout.dofs.push(Dof::Node {
+                        cable,
+                        coordinates: (0..3).map(|axis| self.index(cable, j, axis)).collect(),
+                        tangent: tangent.iter().copied().collect(),
+                        mass: self.node_mass,
+                    });
+                }
+            }
+        }
+        layout
+    }
+}

@@ -1,0 +1,307 @@
+//! Statics of the spatial lumped model (MODELS.md §11): each cable at rest hangs in the vertical
+//! plane through its pulley and the effector, and is found by shooting along the chain; the
+//! reel tensions then carry the effector and the cables' weight.
+//!
+//! One cable, reel tension T (MODELS.md §4's chain at rest): along the reel line each stored
+//! spring carries T less the line-wise weight of the nodes before it, so the straddling spring
+//! carries T_s = T − r m g (r_i·ẑ). Leaving the pulley at angle θ in the cable's plane, its free
+//! share φ λ_s puts P_r at A + φ λ_s e(θ); each free node's balance, f_j = f_{j−1} − m g ẑ, gives
+//! the next spring's force and (taut) length l0 + |f_j|/k0, and the chain is marched to P_N.
+//! Newton on (θ, φ) puts P_N on the effector; φ outside (0, 1] moves the split r by one node.
+//!
+//! The effector: the pose is pinned and the controller's tensions T0 given; the cables' weight
+//! needs a correction, taken as the least one in the tensions' norm, T = T0 + W⁺ δw (the
+//! distribution's own slope when no bound is active), with δw found by Newton on the effector's
+//! balance Σ f_i + M g⃗ = 0.
+
+use super::LumpedSpatial;
+use crate::PULLEY_OFFSET;
+use cdpr_core::model::{CableModel, Equilibrium, ModelError, RestRule};
+use cdpr_core::robot::{PerCable, Tensions};
+use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+
+/// One cable at rest from its reel to the effector.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Hang {
+    /// Stored nodes r.
+    pub stored: usize,
+    /// Nodes P_0 … P_{N−1} [m].
+    pub nodes: Vec<Vector3<f64>>,
+    /// The force the cable exerts on the effector [N] (from the effector toward the cable).
+    pub pull: Vector3<f64>,
+    /// Tension of the straddling spring T_s [N].
+    pub straddle_tension: f64,
+    /// Unstrained length from the pulley to the effector [m].
+    pub free_length: f64,
+}
+
+/// The free part of one march: P_r … P_{N−1}, the end P_N and the last spring's force on it.
+struct March {
+    free: Vec<Vector3<f64>>,
+    end: Vector3<f64>,
+    pull: Vector3<f64>,
+    straddle_tension: f64,
+    straddle_length: f64,
+}
+
+/// Marches cable `cable` from its pulley for split `r`, angle `theta` [rad] in the plane of the
+/// horizontal unit `h` and z, and free share `phi` of the straddling spring.
+fn march(
+    model: &LumpedSpatial,
+    cable: usize,
+    (r, theta, phi): (usize, f64, f64),
+    tension: f64,
+    h: Vector3<f64>,
+) -> March {
+    let (n, l0, k0) = (model.elements, model.segment, model.stiffness);
+    let weight = model.node_mass * model.robot().gravity;
+    let straddle_tension = tension - r as f64 * weight * model.reel(cable).z;
+    let straddle_length = l0 + straddle_tension / k0;
+    let e = h * theta.cos() + Vector3::z() * theta.sin();
+    let mut p = model.pulley(cable) + e * (phi * straddle_length);
+    let mut f = -e * straddle_tension;
+    let mut free = Vec::with_capacity(n - r);
+    for _ in r..n {
+        free.push(p);
+        f.z -= weight;
+        let t = f.norm();
+        p -= f * ((l0 + t / k0) / t);
+    }
+    March {
+        free,
+        end: p,
+        pull: f,
+        straddle_tension,
+        straddle_length,
+    }
+}
+
+/// Horizontal unit vector from the pulley toward `p` (x for a cable hanging plumb).
+fn plane_of(pulley: Vector3<f64>, p: &Vector3<f64>) -> Vector3<f64> {
+    let h = Vector3::new(p.x - pulley.x, p.y - pulley.y, 0.0);
+    if h.norm() > 1e-12 {
+        h.normalize()
+    } else {
+        Vector3::x()
+    }
+}
+
+/// Newton on (θ, φ) for a fixed split r: P_N on `p` to 1e-12 m.
+fn shoot(
+    model: &LumpedSpatial,
+    cable: usize,
+    r: usize,
+    start: (f64, f64),
+    tension: f64,
+    p: &Vector3<f64>,
+) -> Result<(f64, f64), ModelError> {
+    let h = plane_of(model.pulley(cable), p);
+    let miss = |theta: f64, phi: f64| {
+        let d = march(model, cable, (r, theta, phi), tension, h).end - p;
+        Vector2::new(d.dot(&h), d.z)
+    };
+    let (mut theta, mut phi) = start;
+    for _ in 0..60 {
+        let residual = miss(theta, phi);
+        if residual.norm() <= 1e-12 {
+            return Ok((theta, phi));
+        }
+        let step = 1e-7;
+        let d_theta = (miss(theta + step, phi) - miss(theta - step, phi)) / (2.0 * step);
+        let d_phi = (miss(theta, phi + step) - miss(theta, phi - step)) / (2.0 * step);
+        let jacobian = Matrix2::from_columns(&[d_theta, d_phi]);
+        let Some(delta) = jacobian.try_inverse().map(|inv| -(inv * residual)) else {
+            break;
+        };
+        theta += delta.x.clamp(-0.3, 0.3);
+        phi += delta.y;
+    }
+    Err(ModelError::State {
+        t: 0.0,
+        why: format!(
+            "cable {}: no lumped chain of {r} stored nodes hangs from its pulley to the effector \
+             at {:?} m under {tension} N (shooting did not converge)",
+            cable + 1,
+            p.as_slice()
+        ),
+    })
+}
+
+/// Cable `cable` at rest from its reel, pulled by `tension` [N], to the effector at `p` [m].
+pub fn hang(
+    model: &LumpedSpatial,
+    cable: usize,
+    p: &Vector3<f64>,
+    tension: f64,
+) -> Result<Hang, ModelError> {
+    let (n, l0) = (model.elements, model.segment);
+    let pulley = model.pulley(cable);
+    let chord = p - pulley;
+    let h = plane_of(pulley, p);
+    let free = chord.norm() / (1.0 + tension / (model.stiffness * l0));
+    let mut r = (n + 1)
+        .saturating_sub((free / l0).ceil() as usize)
+        .clamp(1, n);
+    let mut guess = (chord.z.atan2(chord.dot(&h)), free / l0 - (n - r) as f64);
+    let mut visited = vec![false; n + 1];
+    loop {
+        visited[r] = true;
+        let (theta, phi) = shoot(model, cable, r, guess, tension, p)?;
+        let next = if phi > 1.0 {
+            (r > 1).then(|| (r - 1, phi - 1.0))
+        } else if phi <= 0.0 {
+            (r < n).then(|| (r + 1, phi + 1.0))
+        } else {
+            return Ok(assemble(model, cable, (r, theta, phi), tension, h));
+        };
+        let Some((next_r, next_phi)) = next.filter(|(k, _)| !visited[*k]) else {
+            return Err(ModelError::State {
+                t: 0.0,
+                why: format!(
+                    "cable {}: no split of its {n} nodes puts the pulley inside the straddling \
+                     spring at {:?} m under {tension} N (free share {phi} with {r} stored: the \
+                     modelled cable is too short, or a node sits on the pulley)",
+                    cable + 1,
+                    p.as_slice()
+                ),
+            });
+        };
+        (r, guess) = (next_r, (theta, next_phi));
+    }
+}
+
+/// The whole chain of a converged march: stored nodes back along the reel line.
+fn assemble(
+    model: &LumpedSpatial,
+    cable: usize,
+    (r, theta, phi): (usize, f64, f64),
+    tension: f64,
+    h: Vector3<f64>,
+) -> Hang {
+    let m = march(model, cable, (r, theta, phi), tension, h);
+    let (l0, k0) = (model.segment, model.stiffness);
+    let weight_along = model.node_mass * model.robot().gravity * model.reel(cable).z;
+    let reel = model.reel(cable);
+    let mut nodes = vec![Vector3::zeros(); model.elements];
+    let behind = ((1.0 - phi) * m.straddle_length).max(PULLEY_OFFSET);
+    nodes[r - 1] = model.pulley(cable) + reel * behind;
+    for j in (0..r - 1).rev() {
+        let t = tension - (j + 1) as f64 * weight_along;
+        nodes[j] = nodes[j + 1] + reel * (l0 + t / k0);
+    }
+    nodes[r..].copy_from_slice(&m.free);
+    Hang {
+        stored: r,
+        nodes,
+        pull: m.pull,
+        straddle_tension: m.straddle_tension,
+        free_length: ((model.elements - r) as f64 + phi) * l0,
+    }
+}
+
+/// The robot at rest at the rule's pose (every coordinate pinned), the tensions corrected by
+/// W⁺ δw to carry the cables' weight (see the module documentation).
+pub(super) fn equilibrium(
+    model: &mut LumpedSpatial,
+    rule: &dyn RestRule<3>,
+) -> Result<Equilibrium, ModelError> {
+    let mut p = Vector3::zeros();
+    if rule.pinned().len() != 3 {
+        return Err(ModelError::State {
+            t: 0.0,
+            why: "the spatial lumped model rests at a pose: all three coordinates pinned".into(),
+        });
+    }
+    for &(axis, value) in rule.pinned() {
+        p[axis] = value;
+    }
+    let base = rule.tensions(&[]);
+    let m = model.robot().cables();
+    let w = model.robot().structure_matrix(&p);
+    let columns = w.columns();
+    let gram: Matrix3<f64> = columns.iter().map(|u| u * u.transpose()).sum();
+    let gram_inv = gram.try_inverse().ok_or_else(|| ModelError::State {
+        t: 0.0,
+        why: format!("the cables do not span space at {:?} m", p.as_slice()),
+    })?;
+    let tensions_for = |dw: &Vector3<f64>| {
+        let lambda = gram_inv * dw;
+        PerCable::from_fn(m, |i| base[i] + columns[i].dot(&lambda))
+    };
+    let lift = model.robot().effector_mass * model.robot().gravity;
+    let residual = |dw: &Vector3<f64>| -> Result<Vector3<f64>, ModelError> {
+        let t = tensions_for(dw);
+        let mut sum = Vector3::new(0.0, 0.0, -lift);
+        for i in 0..m {
+            sum += hang(model, i, &p, t[i])?.pull;
+        }
+        Ok(sum)
+    };
+    let scale = lift + base.iter().map(|t| t.abs()).sum::<f64>();
+    let mut dw = Vector3::zeros();
+    let mut iterations = 0;
+    let mut r = residual(&dw)?;
+    while r.norm() > 1e-11 * scale {
+        if iterations == 30 {
+            return Err(ModelError::State {
+                t: 0.0,
+                why: format!(
+                    "the lumped cables' weight cannot be carried at {:?} m: the effector's \
+                     balance stalled at {:e} N",
+                    p.as_slice(),
+                    r.norm()
+                ),
+            });
+        }
+        let step = 1e-6 * scale;
+        let mut jacobian = Matrix3::zeros();
+        for k in 0..3 {
+            let e = Vector3::ith(k, step);
+            jacobian.set_column(
+                k,
+                &((residual(&(dw + e))? - residual(&(dw - e))?) / (2.0 * step)),
+            );
+        }
+        let Some(inv) = jacobian.try_inverse() else {
+            break;
+        };
+        dw -= inv * r;
+        r = residual(&dw)?;
+        iterations += 1;
+    }
+    let tensions = tensions_for(&dw);
+    let state = rest_state(model, &p, &tensions)?;
+    Ok(Equilibrium {
+        state,
+        parameters: Vec::new(),
+        tensions,
+        iterations,
+        residual: r.norm(),
+    })
+}
+
+/// The state at rest with every cable hanging under `tensions`, and the model's split set.
+fn rest_state(
+    model: &mut LumpedSpatial,
+    p: &Vector3<f64>,
+    tensions: &Tensions,
+) -> Result<Vec<f64>, ModelError> {
+    let m = model.robot().cables();
+    let n = model.elements;
+    let mut state = vec![0.0; model.state_len()];
+    let mut stored = vec![0; m];
+    for (i, split) in stored.iter_mut().enumerate() {
+        let hang = hang(model, i, p, tensions[i])?;
+        *split = hang.stored;
+        for (j, node) in hang.nodes.iter().enumerate() {
+            for axis in 0..3 {
+                state[model.index(i, j, axis)] = node[axis];
+            }
+        }
+    }
+    for axis in 0..3 {
+        state[model.index(0, n, axis)] = p[axis];
+    }
+    model.set_stored(&stored);
+    Ok(state)
+}

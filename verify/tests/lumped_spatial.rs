@@ -1,0 +1,300 @@
+//! The lumped cable in space (MODELS.md §4 along each cable's path, §11) checked from outside:
+//! its statics against its own right-hand side (which the shooting does not use) and against
+//! Irvine's elastic catenary per span; its dynamics against the planar lumped model, an
+//! independent implementation, on a robot whose cables lie in the x–z plane.
+
+use cdpr_bench::core::model::{CableModel, PoseRule};
+use cdpr_bench::core::robot::distribution::{DistributionMethod, TensionBox, distribute};
+use cdpr_bench::core::robot::{Robot, Vector};
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::lumped::spatial::{CableProperties, LumpedSpatial, default_reel_directions, hang};
+use cdpr_bench::lumped::{Lumped, Params};
+use cdpr_verify::irvine::Catenary;
+use nalgebra::Vector3;
+use proptest::prelude::*;
+
+/// The Hangprinter example's anchors [m] (examples/robots/hangprinter.toml).
+const HANGPRINTER: [[f64; 3]; 4] = [
+    [0.0, -1.61098, -0.13153],
+    [1.31422, 1.26814, -0.12128],
+    [-1.41573, 0.70761, -0.12182],
+    [0.0, 0.0, 2.29983],
+];
+
+/// A Hangprinter-like robot with lumped lines of `elements` springs and density ρ [kg/m³]
+/// (the example's line: 970), the anchors moved by `shift` [m].
+fn robot(elements: usize, density: f64, shift: [[f64; 3]; 4]) -> LumpedSpatial {
+    let anchors: Vec<Vector3<f64>> = HANGPRINTER
+        .iter()
+        .zip(shift)
+        .map(|(a, s)| Vector3::from(*a) + Vector3::from(s))
+        .collect();
+    let robot = Robot::new(&anchors, 1.0, 9.81).unwrap();
+    let cable = CableProperties {
+        elements,
+        modelled_length: 3.2,
+        mass_per_length: density * 9.503e-7,
+        axial_stiffness: 2.105e10 * 9.503e-7,
+        axial_damping: 0.0,
+    };
+    LumpedSpatial::new(robot, cable, &default_reel_directions(&anchors)).unwrap()
+}
+
+/// The QP's tensions in [10, 70] N holding the weight at `p`.
+fn holding(model: &LumpedSpatial, p: &Vector3<f64>) -> cdpr_bench::core::robot::Tensions {
+    let w = model.robot().structure_matrix(p);
+    let box_ = TensionBox {
+        t_min: 10.0,
+        t_max: 70.0,
+    };
+    let d = distribute(
+        DistributionMethod::Qp,
+        &w,
+        &Vector::<3>::new(0.0, 0.0, 9.81),
+        box_,
+    )
+    .unwrap();
+    d.tensions
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// At the statics' rest every coordinate's net force vanishes — the effector's, each free
+    /// node's, each stored node's along its reel line — by the model's force assembly, which the
+    /// shooting does not use: to 1e-9 N per node (the shooting ends within 1e-12 m of the
+    /// effector; a spring of k0 = EA/l0 ≈ 1.3e5 N/m turns that into ~1e-7 N at the effector,
+    /// whose balance Newton then closes to 1e-11 of the load), and every cable in the vertical
+    /// plane through its pulley and the effector (any azimuth) to 1e-12 m.
+    #[test]
+    fn the_rest_is_at_rest_and_each_cable_in_its_vertical_plane(
+        x in -0.3..0.3f64,
+        y in -0.3..0.3f64,
+        z in 0.0..0.5f64,
+        density in 970.0..20000.0f64,
+        elements in 6usize..30,
+        shift in prop::array::uniform4(prop::array::uniform3(-0.1..0.1f64)),
+    ) {
+        let mut model = robot(elements, density, shift);
+        let p = Vector3::new(x, y, z);
+        let tensions = holding(&model, &p);
+        let eq = model.equilibrium(&PoseRule::new(&p, tensions)).unwrap();
+        let mut rate = vec![0.0; model.state_len()];
+        model.rhs(0.0, &eq.state, &eq.tensions, &mut rate);
+        let np = model.positions_len();
+        let load = 9.81 + eq.tensions.iter().sum::<f64>();
+        for (k, a) in rate[np..].iter().enumerate() {
+            let mass = if k >= np - 3 { 1.0 } else { model.node_mass };
+            prop_assert!((a * mass).abs() <= 1e-9 * load.max(1.0), "coordinate {k}: {} N", a * mass);
+        }
+        for cable in 0..4 {
+            let a = model.pulley(cable);
+            let normal = Vector3::z().cross(&(p - a)).normalize();
+            for j in model.stored()[cable]..model.elements {
+                let off = (model.node(&eq.state, cable, j) - a).dot(&normal);
+                prop_assert!(off.abs() <= 1e-12, "cable {cable} node {j}: {off} m out of plane");
+            }
+        }
+    }
+}
+
+/// One cable's free span against Irvine's catenary with the same free unstrained length from
+/// the pulley to the effector: the difference of the tension at the pulley and of the force on
+/// the effector, over the tension.
+fn irvine_gap(elements: usize, p: Vector3<f64>, tension: f64, density: f64) -> f64 {
+    let model = robot(elements, density, [[0.0; 3]; 4]);
+    let cable = 0;
+    let h = hang(&model, cable, &p, tension).unwrap();
+    let a = model.pulley(cable);
+    let d = p - a;
+    let horizontal = Vector3::new(d.x, d.y, 0.0);
+    let unit = horizontal.normalize();
+    let c = Catenary::through(
+        [horizontal.norm(), d.z],
+        h.free_length,
+        model.node_mass / model.segment * 9.81,
+        model.stiffness * model.segment,
+    )
+    .unwrap();
+    let at_end = c.vertical + c.weight * h.free_length;
+    let pull = -(unit * c.horizontal + Vector3::z() * at_end);
+    let at_pulley = c.horizontal.hypot(c.vertical);
+    ((h.straddle_tension - at_pulley).abs() + (h.pull - pull).norm()) / tension
+}
+
+/// Irvine per span, first order in 1/N as MODELS.md §4's lumping is: the gap halves when N
+/// doubles (ratio within [0.4, 0.6]) and is below the cable's weight over N (in tension units),
+/// for a heavy line (ρ = 2e4 kg/m³, so the sag is 10 times the example line's) at two poses.
+#[test]
+fn each_span_tends_to_irvines_catenary_at_first_order() {
+    for (p, tension) in [
+        (Vector3::new(0.1, 0.05, 0.02), 15.0),
+        (Vector3::new(-0.2, 0.2, 0.4), 40.0),
+    ] {
+        let gaps: Vec<f64> = [20, 40, 80, 160]
+            .iter()
+            .map(|&n| irvine_gap(n, p, tension, 2e4))
+            .collect();
+        for k in 1..gaps.len() {
+            let ratio = gaps[k] / gaps[k - 1];
+            assert!(
+                (0.4..=0.6).contains(&ratio),
+                "gaps {gaps:?} at {p:?}: ratio {ratio}"
+            );
+        }
+        let weight = 2e4 * 9.503e-7 * 9.81 * 2.0;
+        assert!(gaps[0] * tension < weight / 20.0, "{gaps:?}");
+    }
+}
+
+/// The planar state `planar` (of [`Lumped`]) written into the spatial model's layout, y = 0.
+fn to_spatial(planar: &Lumped, spatial: &LumpedSpatial, y: &[f64]) -> Vec<f64> {
+    let (n, np2, np3) = (
+        planar.elements,
+        planar.positions_len(),
+        spatial.positions_len(),
+    );
+    let mut out = vec![0.0; 2 * np3];
+    for cable in 0..2 {
+        for j in 0..=n {
+            for (axis, from) in [(0, planar.x_index(cable, j)), (2, planar.z_index(cable, j))] {
+                let to = spatial.index(cable, j, axis);
+                out[to] = y[from];
+                out[np3 + to] = y[np2 + from];
+            }
+        }
+    }
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Two cables in the x–z plane: the spatial model's right-hand side, energy and event
+    /// functions equal the planar model's (written independently, MODELS.md §4) on shaken
+    /// states with any stored split and any reel tensions — to 1e-12 relative (the same
+    /// arithmetic, up to a zero y added in), y's rates exactly zero.
+    #[test]
+    fn in_the_plane_it_is_the_planar_model(
+        shake in prop::collection::vec(-0.01..0.01f64, 400),
+        stored in (3usize..37, 3usize..37),
+        tensions in (20.0..200.0f64, 20.0..200.0f64),
+        damping in prop::sample::select(vec![0.0, 2.0]),
+    ) {
+        let mut s = Scenario::paper();
+        s.cable.axial_damping = damping;
+        let mut planar = Lumped::new(&s, Params::default()).unwrap();
+        let anchors = [Vector3::zeros(), Vector3::new(s.robot.anchor_distance, 0.0, 0.0)];
+        let robot = Robot::new(&anchors, s.robot.effector_mass, s.robot.gravity).unwrap();
+        let cable = CableProperties {
+            elements: planar.elements,
+            modelled_length: s.cable.modelled_length,
+            mass_per_length: s.cable.mass_per_length(),
+            axial_stiffness: s.cable.axial_stiffness(),
+            axial_damping: damping,
+        };
+        let mut spatial =
+            LumpedSpatial::new(robot, cable, &default_reel_directions(&anchors)).unwrap();
+        let eq = planar
+            .equilibrium(&cdpr_bench::core::model::SplitRule::new(0.5, 200.0))
+            .unwrap();
+        planar.set_stored([stored.0, stored.1]);
+        spatial.set_stored(&[stored.0, stored.1]);
+        let mut y = eq.state.clone();
+        for (k, v) in y.iter_mut().enumerate() {
+            *v += shake[k % shake.len()] * if k < planar.positions_len() { 0.1 } else { 1.0 };
+        }
+        // Stored nodes on the reel line, as the planar model keeps them.
+        let np = planar.positions_len();
+        for cable in 0..2 {
+            for j in 0..planar.stored()[cable] {
+                let (iz, ix) = (planar.z_index(cable, j), planar.x_index(cable, j));
+                y[iz] = 0.0;
+                y[np + iz] = 0.0;
+                let pulley = planar.pulley(cable).x;
+                y[ix] = pulley + (pulley - y[ix]).abs().max(1e-3) * cdpr_bench::lumped::TOWARD_REEL[cable];
+            }
+        }
+        let y3 = to_spatial(&planar, &spatial, &y);
+        let t = [tensions.0, tensions.1];
+        let (mut r2, mut r3) = (vec![0.0; y.len()], vec![0.0; y3.len()]);
+        planar.rhs(0.0, &y, &t, &mut r2);
+        spatial.rhs(0.0, &y3, &t, &mut r3);
+        let expected = to_spatial(&planar, &spatial, &r2);
+        let scale = expected.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (k, (a, b)) in r3.iter().zip(&expected).enumerate() {
+            prop_assert!((a - b).abs() <= 1e-12 * scale, "rate {k}: {a} vs {b}");
+        }
+        let (e2, e3) = (planar.energy(&y), spatial.energy(&y3));
+        prop_assert!((e2.total() - e3.total()).abs() <= 1e-12 * (e2.elastic + e2.kinetic + e2.gravity.abs()));
+        let (mut g2, mut g3) = (vec![0.0; planar.event_count()], vec![0.0; spatial.event_count()]);
+        planar.event_functions(&y, &mut g2);
+        spatial.event_functions(&y3, &mut g3);
+        for (a, b) in g2.iter().zip(&g3) {
+            prop_assert!((a - b).abs() <= 1e-15, "{g2:?} vs {g3:?}");
+        }
+    }
+}
+
+/// The Hangprinter example's move on lumped lines of `elements` springs and density ρ.
+fn hangprinter_move(kind: &str, elements: usize, density: f64) -> cdpr_bench::SpatialRun {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../examples/robots/hangprinter.toml"
+    ))
+    .unwrap();
+    let mut s: Scenario = cdpr_bench::scenario_from_toml_str(&text).unwrap();
+    s.cable.density = density;
+    s.cable.modelled_length = 3.2;
+    s.simulation.t_final = 0.4;
+    s.simulation.sample_period = 1e-3;
+    let mut table = toml::Table::new();
+    table.insert("kind".into(), kind.into());
+    if kind == "lumped" {
+        table.insert("elements".into(), (elements as i64).into());
+    }
+    s.model = cdpr_bench::core::scenario::ModelSection(table);
+    cdpr_bench::simulate_spatial(
+        &s,
+        &mut cdpr_bench::core::runner::Observer::progress(&mut |_| {}),
+    )
+    .unwrap()
+}
+
+/// Largest distance between the effector paths of two runs [m].
+fn path_gap(a: &cdpr_bench::SpatialRun, b: &cdpr_bench::SpatialRun) -> f64 {
+    let axis = |r: &cdpr_bench::SpatialRun, name: &str| r.run.series.column_named(name).unwrap();
+    let mut gap = 0.0f64;
+    for name in ["x", "y", "z"] {
+        let (a, b) = (axis(a, name), axis(b, name));
+        gap = a.iter().zip(&b).fold(gap, |m, (a, b)| m.max((a - b).abs()));
+    }
+    gap
+}
+
+/// The example's move (computed torque, QP) on lumped lines of 20 springs: nodes cross the
+/// pulleys (events), and the energy balance E − E0 − W_reels + D − ΣΔE closes to 1e-5 J
+/// (measured 1.4e-7 J at DOPRI5's rtol 1e-5; the reels' work is ~1 J, so a wrong sign or a lost
+/// term shows by orders of magnitude). As the line's mass goes to zero the effector's path
+/// tends to the massless elastic model's at first order: halving ρ halves the largest gap
+/// (ratio within [0.4, 0.6]; measured 1.8 µm at the example's ρ = 970 kg/m³).
+#[test]
+fn the_hangprinter_move_runs_on_lumped_lines_and_tends_to_elastic() {
+    let elastic = hangprinter_move("elastic", 0, 970.0);
+    let heavy = hangprinter_move("lumped", 20, 970.0);
+    let light = hangprinter_move("lumped", 20, 485.0);
+    let residual = heavy
+        .run
+        .series
+        .column(cdpr_bench::core::channel::Channel::EResidual)
+        .unwrap();
+    let worst = residual.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(!heavy.run.events.is_empty(), "no node crossed a pulley");
+    assert!(worst < 1e-5, "energy balance residual {worst:e} J");
+    let (gap_heavy, gap_light) = (path_gap(&heavy, &elastic), path_gap(&light, &elastic));
+    let ratio = gap_light / gap_heavy;
+    assert!(
+        (0.4..=0.6).contains(&ratio),
+        "gaps {gap_heavy:e} m (ρ = 970), {gap_light:e} m (ρ = 485)"
+    );
+}
