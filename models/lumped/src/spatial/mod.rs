@@ -64,6 +64,9 @@ pub struct LumpedSpatial {
     reels: [Vector3<f64>; MAX_CABLES],
     /// Stored nodes r_i of each cable (nodes 0 … r_i − 1 lie on the reel line).
     stored: [usize; MAX_CABLES],
+    /// Reels locked: every reel end P_0 held where it is (the commanded tensions then act on
+    /// nothing that moves).
+    locked: bool,
     /// Per cable, the forces of its springs on their two end nodes (allocated once).
     scratch: Vec<SpringForces>,
 }
@@ -76,25 +79,30 @@ struct SpringForces {
 }
 
 /// The default reel direction of each anchor (MODELS.md §11): horizontal, away from the anchors'
-/// centroid (+x for an anchor straight above or below it).
+/// centroid — but for an anchor whose horizontal offset from the centroid is smaller than its
+/// vertical one (a ceiling anchor such as Hangprinter's D), vertical, away from the centroid: a
+/// horizontal reel line there would put the anchor's own plumb line on the boundary of the
+/// pulley's side rule.
 pub fn default_reel_directions(anchors: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
     let centroid = anchors.iter().sum::<Vector3<f64>>() / anchors.len() as f64;
     anchors
         .iter()
         .map(|a| {
-            let away = Vector3::new(a.x - centroid.x, a.y - centroid.y, 0.0);
-            if away.norm() > 1e-9 {
-                away.normalize()
+            let away = a - centroid;
+            let horizontal = Vector3::new(away.x, away.y, 0.0);
+            if horizontal.norm() >= away.z.abs() {
+                horizontal.normalize()
             } else {
-                Vector3::x()
+                Vector3::z() * away.z.signum()
             }
         })
         .collect()
 }
 
 impl LumpedSpatial {
-    /// The robot's cables lumped, reeled along `reels` (unit vectors, checked to point away from
-    /// the anchors' centroid, i.e. out of the workspace); r_i are set by the statics.
+    /// The robot's cables lumped, reeled along `reels` (checked not to point into the workspace,
+    /// (A_i − centroid)·r_i ≥ 0, so that a top anchor may reel horizontally); r_i are set by the
+    /// statics.
     pub fn new(
         robot: Robot<3>,
         cable: CableProperties,
@@ -115,14 +123,15 @@ impl LumpedSpatial {
         for (i, r) in reels.iter().enumerate().take(m) {
             let norm = r.norm();
             let outward = (robot.anchor(i) - centroid).dot(r);
-            if !(norm.is_finite() && norm > 0.0 && outward > 0.0) {
+            let tolerance = -1e-9 * (robot.anchor(i) - centroid).norm();
+            if !(norm.is_finite() && norm > 0.0 && outward >= tolerance) {
                 return Err(ModelError::Parameter {
                     name: "robot.reel_directions",
                     value: outward,
                     allowed: format!(
-                        "cable {}: a nonzero direction [{}, {}, {}] pointing away from the \
-                         anchors' centroid (its dot product with A_i − centroid > 0): the reel \
-                         line must leave the workspace",
+                        "cable {}: a nonzero direction [{}, {}, {}] not pointing into the \
+                         workspace (its dot product with A_i − the anchors' centroid ≥ 0): the \
+                         reel line must leave the workspace",
                         i + 1,
                         r.x,
                         r.y,
@@ -149,6 +158,7 @@ impl LumpedSpatial {
             damping: cable.axial_damping / segment,
             reels: units,
             stored: [n / 2; MAX_CABLES],
+            locked: false,
             scratch: vec![
                 SpringForces {
                     a: std::array::from_fn(|_| vec![0.0; n]),
@@ -187,6 +197,7 @@ impl LumpedSpatial {
         };
         let model = Self::new(robot, cable, &reels)?;
         if let Ok((start, end)) = scenario.trajectory.spatial_move() {
+            model.check_free_side(&[Vector3::from(start), Vector3::from(end)])?;
             let chord = [start, end]
                 .iter()
                 .flat_map(|p| {
@@ -208,6 +219,37 @@ impl LumpedSpatial {
             }
         }
         Ok(model)
+    }
+
+    /// Each of `poses` [m] on the free side of every cable's pulley ((p − A_i)·r_i < 0 by more
+    /// than a segment): an effector on a reel line's side has no free cable.
+    pub fn check_free_side(&self, poses: &[Vector3<f64>]) -> Result<(), ModelError> {
+        for p in poses {
+            for i in 0..self.robot.cables() {
+                let beyond = (p - self.pulley(i)).dot(&self.reels[i]);
+                if beyond > -self.segment {
+                    return Err(ModelError::Parameter {
+                        name: "robot.reel_directions",
+                        value: beyond,
+                        allowed: format!(
+                            "cable {}: the effector at {:?} m lies {beyond:.4} m along the reel \
+                             direction from its pulley; it must lie more than a segment \
+                             ({:.4} m) on the free side (< 0)",
+                            i + 1,
+                            p.as_slice(),
+                            -self.segment
+                        ),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Locks (or frees) every reel: a locked reel holds its reel end P_0 still, the length
+    /// reels holding still; the robot is then a conservative system (no reel work).
+    pub fn lock_reels(&mut self, locked: bool) {
+        self.locked = locked;
     }
 
     /// Stored nodes per cable, r_i.
@@ -428,6 +470,15 @@ impl CableModel<3> for LumpedSpatial {
         dv[cables..]
             .iter_mut()
             .for_each(|a| *a /= self.robot.effector_mass);
+        // A locked reel holds its reel end.
+        if self.locked {
+            for cable in 0..self.robot.cables() {
+                for axis in 0..3 {
+                    let i = self.index(cable, 0, axis);
+                    (dq[i], dv[i]) = (0.0, 0.0);
+                }
+            }
+        }
         // Stored nodes move along their reel line only.
         for cable in 0..self.robot.cables() {
             let reel = self.reels[cable];
