@@ -81,8 +81,8 @@ pub fn spatial_robot(scenario: &Scenario) -> Result<Robot<3>, Error> {
 }
 
 /// The scenario's spatial robot and the cable model its move runs, checked: the massless elastic
-/// cables, or the lumped ones (MODELS.md §4 in space) under a tension controller on DOPRI5 —
-/// the length reels, the implicit path and printing on lumped cables are refused by name.
+/// cables, or the lumped ones (MODELS.md §4 in space) under a tension controller — the length
+/// reels and printing on lumped cables are refused by name.
 fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Error> {
     let robot = scenario.spatial_robot().ok_or_else(|| {
         out_of_range(
@@ -110,10 +110,10 @@ fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Error> {
     Ok((robot, config.kind))
 }
 
-/// What the spatial lumped cables run so far: three or more cables, tension reels, DOPRI5, a
-/// move (not a print).
+/// What the spatial lumped cables run so far: three or more cables, tension reels, a move (not a
+/// print).
 fn check_lumped(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
-    use cdpr_core::scenario::{ControllerKind, IntegratorKind};
+    use cdpr_core::scenario::ControllerKind;
     let refuse = |key: &'static str, value: String, allowed: &str| -> Result<(), Error> {
         Err(out_of_range(key, value, allowed.to_owned()).into())
     };
@@ -129,13 +129,6 @@ fn check_lumped(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
             "controller.kind",
             "\"length\" with model.kind = \"lumped\"".into(),
             "a tension controller: reels driven by length on massive cables are not built yet",
-        );
-    }
-    if scenario.simulation.integrator != IntegratorKind::Dopri5 {
-        return refuse(
-            "simulation.integrator",
-            format!("\"{}\"", scenario.simulation.integrator.name()),
-            "\"dopri5\" for the spatial lumped cables (their implicit form is not built yet)",
         );
     }
     if scenario.printer.is_some() {

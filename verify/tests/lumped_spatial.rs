@@ -238,6 +238,17 @@ proptest! {
 
 /// The Hangprinter example's move on lumped lines of `elements` springs and density ρ.
 fn hangprinter_move(kind: &str, elements: usize, density: f64) -> cdpr_bench::SpatialRun {
+    hangprinter_move_on(kind, elements, density, None)
+}
+
+/// [`hangprinter_move`] on the implicit path with a fixed `step` [s] (None: DOPRI5 at the
+/// default tolerance; 0: DOPRI5 at rtol 1e-10).
+fn hangprinter_move_on(
+    kind: &str,
+    elements: usize,
+    density: f64,
+    step: Option<f64>,
+) -> cdpr_bench::SpatialRun {
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../examples/robots/hangprinter.toml"
@@ -254,6 +265,18 @@ fn hangprinter_move(kind: &str, elements: usize, density: f64) -> cdpr_bench::Sp
         table.insert("elements".into(), (elements as i64).into());
     }
     s.model = cdpr_bench::core::scenario::ModelSection(table);
+    match step {
+        // Step 0: DOPRI5 at rtol 1e-10, far below the implicit path's error (the reference).
+        Some(0.0) => {
+            s.simulation.rtol = 1e-10;
+            s.simulation.atol = 1e-13;
+        }
+        Some(h) => {
+            s.simulation.integrator = cdpr_bench::core::scenario::IntegratorKind::Implicit;
+            s.simulation.step = h;
+        }
+        None => {}
+    }
     cdpr_bench::simulate_spatial(
         &s,
         &mut cdpr_bench::core::runner::Observer::progress(&mut |_| {}),
@@ -297,4 +320,117 @@ fn the_hangprinter_move_runs_on_lumped_lines_and_tends_to_elastic() {
         (0.4..=0.6).contains(&ratio),
         "gaps {gap_heavy:e} m (ρ = 970), {gap_light:e} m (ρ = 485)"
     );
+}
+
+/// Largest distance between the effector paths of two runs up to `until` [s].
+fn path_gap_until(a: &cdpr_bench::SpatialRun, b: &cdpr_bench::SpatialRun, until: f64) -> f64 {
+    let t = a.run.series.column_named("t").unwrap();
+    let axis = |r: &cdpr_bench::SpatialRun, name: &str| r.run.series.column_named(name).unwrap();
+    let mut gap = 0.0f64;
+    for name in ["x", "y", "z"] {
+        let (a, b) = (axis(a, name), axis(b, name));
+        for k in (0..t.len()).take_while(|&k| t[k] <= until) {
+            gap = gap.max((a[k] - b[k]).abs());
+        }
+    }
+    gap
+}
+
+/// The implicit path (generalised-α on the second-order form) converges to DOPRI5's path (at
+/// rtol 1e-10) at second order over the first 0.05 s, before any node crosses a pulley: the
+/// gap shrinks by 3.2–5 when the step halves from 1e-4 to 5e-5 s (2² = 4 asymptotically;
+/// measured ratios 1.9, 3.2, 3.8, 4.0 for steps 4e-4 … 2.5e-5 s). From the first crossing on
+/// (0.0645 s) the paths differ by ~5e-8 m at any step down to 5e-6 s: the crossing's instant
+/// rides on the undamped lines' axial ringing (~8 µm at ~9 kHz, which the implicit path damps
+/// and DOPRI5 carries), so the node is released a few µs apart; the whole run stays within
+/// 2e-7 m (measured 6.4e-8 m at 1e-4 s).
+#[test]
+fn the_implicit_path_converges_to_dormand_prince_at_second_order() {
+    let reference = hangprinter_move_on("lumped", 20, 970.0, Some(0.0));
+    let coarse = hangprinter_move_on("lumped", 20, 970.0, Some(1e-4));
+    let fine = hangprinter_move_on("lumped", 20, 970.0, Some(5e-5));
+    let first = reference.run.events[0].t;
+    assert!(first > 0.05, "first crossing at {first} s");
+    let window = 0.05;
+    let (gap_coarse, gap_fine) = (
+        path_gap_until(&coarse, &reference, window),
+        path_gap_until(&fine, &reference, window),
+    );
+    assert!(
+        (3.2..=5.0).contains(&(gap_coarse / gap_fine)),
+        "gaps before the first crossing: {gap_coarse:e} m (1e-4 s), {gap_fine:e} m (5e-5 s)"
+    );
+    let whole = path_gap(&coarse, &reference);
+    assert!(whole < 2e-7, "{whole:e} m over the run");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// The analytic iteration matrix (undamped lines) against coloured central differences of
+    /// the residual (the same robot with damped lines, whose residual equals the undamped one
+    /// at zero velocity and so does its position derivative), at rests shaken by up to 1e-4 m
+    /// per coordinate, with any stored split the rest gives, over c_q of h = 1e-5 … 1e-3 s.
+    /// Compared on c_q ∂F/∂q alone (the masses would swamp it), to 1e-6 of its largest entry:
+    /// the differences' truncation is (δ/λ)² with δ ≤ a quarter of the stretch (~1e-4 m
+    /// here) and λ ≈ l0 = 0.16 m, ~1e-7; a missing geometric term T/λ ≈ 400 N/m is 3e-3 of the
+    /// axial k0 = 1.25e5 N/m.
+    #[test]
+    fn the_tangent_matrix_matches_coloured_differences(
+        x in -0.3..0.3f64,
+        y in -0.3..0.3f64,
+        z in 0.0..0.5f64,
+        shake in 0.0..1e-4f64,
+        seed in 0u32..1000,
+        h in 1e-5f64..1e-3,
+    ) {
+        use cdpr_bench::core::second_order::SecondOrderForm;
+        let mut model = robot(20, 2e4, [[0.0; 3]; 4]);
+        let p = Vector3::new(x, y, z);
+        let tensions = holding(&model, &p);
+        let eq = model.equilibrium(&PoseRule::new(&p, tensions)).unwrap();
+        let mut damped = LumpedSpatial::new(
+            *model.robot(),
+            CableProperties {
+                elements: 20,
+                modelled_length: 3.2,
+                mass_per_length: 2e4 * 9.503e-7,
+                axial_stiffness: 2.105e10 * 9.503e-7,
+                axial_damping: 1.0,
+            },
+            &default_reel_directions(model.robot().anchors()),
+        )
+        .unwrap();
+        damped.set_stored(model.stored());
+        let mut state = eq.state.clone();
+        for (k, q) in state[..model.positions_len()].iter_mut().enumerate() {
+            *q += shake * (1.7 * (f64::from(seed) + k as f64)).sin();
+        }
+        // Stored nodes back on their reel lines.
+        for cable in 0..4 {
+            let (a, r) = (model.pulley(cable), model.reel(cable));
+            for j in 0..model.stored()[cable] {
+                let on_line = a + r * (model.node(&state, cable, j) - a).dot(&r);
+                for axis in 0..3 {
+                    state[model.index(cable, j, axis)] = on_line[axis];
+                }
+            }
+        }
+        let c_q = 0.3 * h * h;
+        let n = model.dofs();
+        let qdd = vec![0.0; n];
+        let len = model.iteration_pattern().len();
+        let (mut analytic, mut differenced, mut masses) = (vec![0.0; len], vec![0.0; len], vec![0.0; len]);
+        model.iteration_matrix(&state, &qdd, &eq.tensions, 0.0, c_q, &mut analytic);
+        damped.iteration_matrix(&state, &qdd, &eq.tensions, 0.0, c_q, &mut differenced);
+        model.iteration_matrix(&state, &qdd, &eq.tensions, 0.0, 0.0, &mut masses);
+        let scale = differenced
+            .iter()
+            .zip(&masses)
+            .fold(0.0f64, |m, (v, mass)| m.max((v - mass).abs()));
+        prop_assert!(scale > 0.0);
+        for (i, (a, d)) in analytic.iter().zip(&differenced).enumerate() {
+            prop_assert!((a - d).abs() <= 1e-6 * scale, "entry {}: {:e} vs {:e} (scale {:e})", i, a, d, scale);
+        }
+    }
 }

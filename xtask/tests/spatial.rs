@@ -163,7 +163,7 @@ fn hangprinter_move_on_lumped_lines_writes_its_cable_channels() {
 
 /// Refused before any file: a reference the box cannot follow (named with time, pose, cable),
 /// a robot described for its statics only (no move), the FE cables in space, and lumped lines
-/// too short for the move, reeled into the workspace, on length reels or on the implicit path.
+/// too short for the move, reeled into the workspace or on length reels.
 #[test]
 fn spatial_runs_are_refused_before_any_file() {
     let dir = TempDir::new("spatial-refusals");
@@ -177,8 +177,7 @@ fn spatial_runs_are_refused_before_any_file() {
         "effector_mass = 1.0\nreel_directions = [[0, -1, 0], [1, 1, 0], [-1, 0, 0], [0, 0, -1]]",
     );
     let length = long(model("kind = \"lumped\"")).replace("\"computed-torque\"", "\"length\"");
-    let implicit = long(model("kind = \"lumped\""))
-        .replace("t_final = 1.5", "t_final = 1.5\nintegrator = \"implicit\"");
+
     for (file, text, expected) in [
         ("fast.toml", fast, "wrench-feasible workspace at t ="),
         ("fe.toml", model("kind = \"fe\""), "model.kind"),
@@ -189,7 +188,6 @@ fn spatial_runs_are_refused_before_any_file() {
         ),
         ("inward.toml", inward, "robot.reel_directions"),
         ("length.toml", length, "controller.kind"),
-        ("implicit.toml", implicit, "simulation.integrator"),
     ] {
         let path = dir.join(file);
         std::fs::write(&path, text).unwrap();

@@ -19,6 +19,7 @@
 //! sweep vectorises), then the effector's (x, y, z): 3mN + 3 positions, then the velocities in
 //! the same order. The stored-node counts r_i are the model's discrete mode.
 
+mod implicit;
 mod pulley;
 mod statics;
 
@@ -69,6 +70,8 @@ pub struct LumpedSpatial {
     locked: bool,
     /// Per cable, the forces of its springs on their two end nodes (allocated once).
     scratch: Vec<SpringForces>,
+    /// Buffers of the second-order form ([`implicit`]).
+    implicit: implicit::ImplicitScratch,
 }
 
 /// Forces of springs j = 0 … N−1 on their end nodes a = P_j and b = P_{j+1} [N], per axis.
@@ -159,6 +162,7 @@ impl LumpedSpatial {
             reels: units,
             stored: [n / 2; MAX_CABLES],
             locked: false,
+            implicit: Default::default(),
             scratch: vec![
                 SpringForces {
                     a: std::array::from_fn(|_| vec![0.0; n]),
@@ -582,6 +586,14 @@ impl CableModel<3> for LumpedSpatial {
             out[2 * m + c] = self.free_length(y, c);
             out[3 * m + c] = r as f64;
         }
+    }
+
+    fn second_order(&self) -> Option<&dyn cdpr_core::second_order::SecondOrderForm> {
+        Some(self)
+    }
+
+    fn second_order_mut(&mut self) -> Option<&mut dyn cdpr_core::second_order::SecondOrderForm> {
+        Some(self)
     }
 
     /// The effector and each free node with its cable's tangent; a stored node moves material
