@@ -113,8 +113,15 @@ impl SpatialMetrics {
         let saturated = column(Channel::Saturated);
         let saturated_s = saturated.iter().filter(|&&v| v != 0.0).count() as f64
             * t.get(1).map_or(0.0, |t1| t1 - t[0]);
+        // The paid-out unstrained length: the elastic model's l0_i, a massive model's free
+        // unstrained length l_free_i (its rate is the cable's passage over the pulley).
         let reel_speed_max = (1..=m)
-            .map(|i| max_rate(t, s.channel_named(&format!("l0_{i}")).unwrap_or(&[])))
+            .map(|i| {
+                let paid_out = s
+                    .channel_named(&format!("l0_{i}"))
+                    .or_else(|| s.channel_named(&format!("l_free_{i}")));
+                max_rate(t, paid_out.unwrap_or(&[]))
+            })
             .collect();
         let after = context.move_end + 1.0;
         Self {

@@ -1,9 +1,11 @@
 //! A spatial robot's move under every controller and every tension distribution
 //! (`cargo xtask spatial-moves`): the table of docs/spatial.md — path error during the move and
 //! 1 s after it, the tension range, the time the limits clamped the command, and the reels'
-//! largest speed. The firmware's `length` controller is run with each flex compensation.
+//! largest speed. The firmware's `length` controller is run with each flex compensation (on
+//! the elastic cables; lumped lines run the tension controllers).
 
 use crate::Result;
+use cdpr_bench::ModelKind;
 use cdpr_bench::analysis::spatial::SpatialMetrics;
 use cdpr_bench::core::robot::distribution::DistributionMethod;
 use cdpr_bench::core::runner::Observer;
@@ -54,7 +56,13 @@ fn flex_name(flex: FlexCompensation) -> &'static str {
 /// table's order, whatever the machine).
 pub fn table(scenario: &Scenario) -> Result<Vec<MoveRow>> {
     let mut jobs = Vec::new();
+    // Lumped lines run the tension controllers only (length reels on massive cables are not
+    // built yet).
+    let massive = cdpr_bench::ModelConfig::from_scenario(scenario)?.kind != ModelKind::Elastic;
     for (name, kind, flex) in controllers() {
+        if massive && kind == ControllerKind::Length {
+            continue;
+        }
         for method in DistributionMethod::ALL {
             let mut s = scenario.clone();
             s.controller.kind = kind;

@@ -20,32 +20,26 @@ use nalgebra::Vector3;
 /// Functions per cable: last stored node, first free node, ordering watch.
 pub(super) const PER_CABLE: usize = 3;
 
-/// Signed distance of node j of `cable` beyond its pulley along r_i (> 0: on the reel side) [m].
-pub(super) fn beyond(model: &LumpedSpatial, y: &[f64], cable: usize, j: usize) -> f64 {
-    (model.node(y, cable, j) - model.pulley(cable)).dot(&model.reel(cable))
-}
-
-/// All event functions, positive while nothing happens.
+/// All event functions, positive while nothing happens. Each cable's signed distances beyond its
+/// pulley come from its three contiguous coordinate slices in one sweep (this runs at every
+/// step).
 pub(super) fn event_functions(model: &LumpedSpatial, y: &[f64], out: &mut [f64]) {
     let n = model.elements;
     for cable in 0..model.robot().cables() {
         let r = model.stored()[cable];
+        let (a, reel) = (model.pulley(cable), model.reel(cable));
+        let offset = a.dot(&reel);
+        let at = |axis: usize| &y[model.index(cable, 0, axis)..][..n];
+        let (x, yy, z) = (at(0), at(1), at(2));
+        let beyond = |j: usize| x[j] * reel.x + yy[j] * reel.y + z[j] * reel.z - offset;
         let g = &mut out[PER_CABLE * cable..PER_CABLE * (cable + 1)];
-        g[0] = if r > 0 {
-            beyond(model, y, cable, r - 1)
-        } else {
-            1.0
-        };
-        g[1] = if r < n {
-            -beyond(model, y, cable, r)
-        } else {
-            1.0
-        };
+        g[0] = if r > 0 { beyond(r - 1) } else { 1.0 };
+        g[1] = if r < n { -beyond(r) } else { 1.0 };
         let stored_watch = (0..r.saturating_sub(1))
-            .map(|j| beyond(model, y, cable, j))
+            .map(beyond)
             .fold(f64::INFINITY, f64::min);
         let free_watch = ((r + 1).min(n)..n)
-            .map(|j| -beyond(model, y, cable, j))
+            .map(|j| -beyond(j))
             .fold(f64::INFINITY, f64::min);
         g[2] = stored_watch.min(free_watch).min(1.0);
     }
