@@ -8,6 +8,7 @@
 //! | the paper on every model, checked against MODELS.md §8 | [`paper`] | `cargo xtask report` |
 //! | every controller on every model (the leaderboard) | [`control`] | `cargo xtask control` |
 //! | a spatial robot's tension distributions at a pose | [`distribution`] | `cargo xtask distribution` |
+//! | firmware flex compensation on sagging lines, over a grid | [`flex_error`] | `cargo xtask flex-error` |
 //! | every input shaper on every model | [`shaping`] | `cargo xtask shaping` |
 //! | a spatial robot's modes at a pose, with their directions | [`spatial_modes`] | `cargo xtask modes --at X,Y,Z` |
 //! | a spatial robot's move, every controller × distribution | [`spatial_moves`] | `cargo xtask spatial-moves` |
@@ -19,6 +20,7 @@
 
 pub mod control;
 pub mod distribution;
+pub mod flex_error;
 pub mod modes;
 pub mod paper;
 pub mod paper_report;

@@ -434,3 +434,151 @@ proptest! {
         }
     }
 }
+
+/// The firmware's static flex compensation on lumped lines: at `p` the QP's tensions holding
+/// the weight, the unstrained lengths l_i/(1 + T_i/EA) the firmware commands (MODELS.md §11),
+/// and where the effector rests with the reels locked at them. Returns the rest pose and the
+/// robot.
+fn firmware_rest(elements: usize, density: f64, p: Vector3<f64>) -> (Vector3<f64>, LumpedSpatial) {
+    let model = robot(elements, density, [[0.0; 3]; 4]);
+    let tensions = holding(&model, &p);
+    let ea = model.stiffness * model.segment;
+    let lengths: Vec<f64> = (0..4)
+        .map(|i| (model.pulley(i) - p).norm() / (1.0 + tensions[i] / ea))
+        .collect();
+    let (rest, _) = cdpr_bench::lumped::spatial::rest_with_lengths(&model, &p, &lengths).unwrap();
+    (rest, model)
+}
+
+/// Where the lumped rest with locked reels puts the effector, each line's Irvine catenary with
+/// the line's free unstrained length (from the lumped statics) pulls it; with the weight their
+/// sum is the continuous cables' imbalance there, which the lumping's first-order error leaves:
+/// it halves when N doubles (for a line 20 times the example's density: 5.9e-2, 2.9e-2,
+/// 1.5e-2 N at N = 20, 40, 80; ratio within 0.4–0.6). The rest moves off the commanded pose with
+/// the lines' mass at first order (the firmware's flex compensation is exact for massless
+/// straight lines): halving ρ from 1250 to 625 kg/m³ halves the error (ratio within
+/// 0.45–0.55; from 2e4 kg/m³ down the ratios are 0.40, 0.44, 0.47, 0.48, 0.49 as a μ² part
+/// fades; the error is 88 µm at 2e4 kg/m³, 1.7 µm at 625).
+#[test]
+fn locked_reels_at_the_firmwares_lengths_rest_where_irvine_balances() {
+    let p = Vector3::new(0.1, 0.05, 0.3);
+    let imbalance = |n: usize| {
+        let (rest, model) = firmware_rest(n, 2e4, p);
+        let ea = model.stiffness * model.segment;
+        let w = model.node_mass / model.segment * 9.81;
+        let tensions = holding(&model, &p);
+        let mut sum = Vector3::new(0.0, 0.0, -9.81);
+        for i in 0..4 {
+            let a = model.pulley(i);
+            let free = (a - p).norm() / (1.0 + tensions[i] / ea);
+            let d = rest - a;
+            let horizontal = Vector3::new(d.x, d.y, 0.0);
+            let c = Catenary::through([horizontal.norm(), d.z], free, w, ea).unwrap();
+            let at_end = c.vertical + c.weight * free;
+            sum -= horizontal.normalize() * c.horizontal + Vector3::z() * at_end;
+        }
+        sum.norm()
+    };
+    let (i20, i40, i80) = (imbalance(20), imbalance(40), imbalance(80));
+    for ratio in [i40 / i20, i80 / i40] {
+        assert!(
+            (0.4..=0.6).contains(&ratio),
+            "imbalances {i20:e}, {i40:e}, {i80:e} N"
+        );
+    }
+    let (heavy, _) = firmware_rest(40, 1250.0, p);
+    let (light, _) = firmware_rest(40, 625.0, p);
+    let ratio = (light - p).norm() / (heavy - p).norm();
+    assert!(
+        (0.45..=0.55).contains(&ratio),
+        "rest errors {} m, {} m",
+        (heavy - p).norm(),
+        (light - p).norm()
+    );
+}
+
+/// Where the effector of `anchors` rests on continuous lines (Irvine's elastic catenary per
+/// span, weight `w` [N/m], axial stiffness `ea` [N]) locked at unstrained free `lengths` [m]:
+/// Newton on the effector's balance from `guess`, central differences of 1e-7 m. Written here
+/// from the catenary alone: none of the lumped model's statics.
+fn irvine_rest(
+    anchors: &[Vector3<f64>],
+    lengths: &[f64],
+    (w, ea, weight): (f64, f64, f64),
+    guess: Vector3<f64>,
+) -> Vector3<f64> {
+    let balance = |p: Vector3<f64>| {
+        let mut sum = Vector3::new(0.0, 0.0, -weight);
+        for (a, &l) in anchors.iter().zip(lengths) {
+            let d = p - a;
+            let horizontal = Vector3::new(d.x, d.y, 0.0);
+            let c = Catenary::through([horizontal.norm(), d.z], l, w, ea).unwrap();
+            sum -= horizontal.normalize() * c.horizontal + Vector3::z() * (c.vertical + w * l);
+        }
+        sum
+    };
+    let mut p = guess;
+    for _ in 0..30 {
+        let r = balance(p);
+        if r.norm() < 1e-9 * weight {
+            break;
+        }
+        let mut jacobian = nalgebra::Matrix3::zeros();
+        for k in 0..3 {
+            let e = Vector3::ith(k, 1e-7);
+            jacobian.set_column(k, &((balance(p + e) - balance(p - e)) / 2e-7));
+        }
+        p -= jacobian.try_inverse().unwrap() * r;
+    }
+    p
+}
+
+/// `cargo xtask flex-error`'s study on the CoGiRo example's 4 mm steel lines at its worst target
+/// (the box's corner [−4, 3, 0.5] m, where the firmware's straight-line lengths leave the
+/// effector 1.9 mm off): the lumped rest tends at first order to the rest on continuous lines
+/// computed here from Irvine's catenary (gap ratio within 0.4–0.6 when N doubles; measured 17.7,
+/// 8.3, 4.3 µm at N = 20, 40, 80), and at N = 80 lies within 1 % of the error it measures from
+/// it (the continuous lines' rest is 1.884 mm off the target).
+#[test]
+fn the_flex_error_study_tends_to_the_continuous_lines() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../examples/robots/cogiro-lumped.toml"
+    );
+    let s = cdpr_bench::scenario_from_file(std::path::Path::new(path)).unwrap();
+    let target = [-4.0, 3.0, 0.5];
+    let study = |n: usize| {
+        let points = cdpr_studies::flex_error::over_box(&s, target, target, 1, n)
+            .unwrap()
+            .points;
+        points[0].clone()
+    };
+    let anchors: Vec<Vector3<f64>> = s
+        .robot
+        .anchors
+        .as_ref()
+        .unwrap()
+        .iter()
+        .map(|a| Vector3::new(a[0], a[1], a[2]))
+        .collect();
+    let ea = s.cable.axial_stiffness();
+    let first = study(20);
+    let lengths: Vec<f64> = anchors
+        .iter()
+        .zip(&first.assumed_tensions)
+        .map(|(a, t)| (a - Vector3::from(target)).norm() / (1.0 + t / ea))
+        .collect();
+    let weight = s.robot.effector_mass * s.robot.gravity;
+    let w = s.cable.mass_per_length() * s.robot.gravity;
+    let continuous = irvine_rest(&anchors, &lengths, (w, ea, weight), Vector3::from(target));
+    let gap = |p: &cdpr_studies::flex_error::FlexPoint| (Vector3::from(p.rest) - continuous).norm();
+    let (g20, g40, g80) = (gap(&first), gap(&study(40)), gap(&study(80)));
+    for ratio in [g40 / g20, g80 / g40] {
+        assert!(
+            (0.4..=0.6).contains(&ratio),
+            "gaps {g20:e}, {g40:e}, {g80:e} m"
+        );
+    }
+    let error = (continuous - Vector3::from(target)).norm();
+    assert!(g80 < 0.01 * error, "{g80:e} m of {error:e} m");
+}

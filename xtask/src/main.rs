@@ -14,6 +14,7 @@ mod control;
 mod csv_stream;
 mod distribution;
 mod figures;
+mod flex_error;
 mod heatmap;
 mod modes;
 mod output;
@@ -218,6 +219,32 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Firmware's static flex compensation on sagging lines: over a grid of targets in a box,
+    /// the lengths the firmware commands (straight elastic lines holding the weight), the rest
+    /// of the effector with the reels locked there on the lumped lines, and the position error
+    /// → DIR/flex-error.json and DIR/flex-error.md.
+    FlexError {
+        /// Scenario file with `[robot] anchors` and its line (`[cable]`, `modelled_length`).
+        #[arg(long)]
+        scenario: PathBuf,
+        /// The box of targets: X0,X1,Y0,Y1,Z0,Z1 [m].
+        #[arg(
+            long = "box",
+            value_delimiter = ',',
+            num_args = 1,
+            allow_negative_numbers = true
+        )]
+        bounds: Vec<f64>,
+        /// Targets per axis (the grid has this many cubed).
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=50))]
+        points: u32,
+        /// Springs per line of the lumped statics.
+        #[arg(long, default_value_t = 40, value_parser = clap::value_parser!(u32).range(3..=2000))]
+        elements: u32,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// A parameter study: every point of a grid file (a base scenario and axes over dotted
     /// scenario keys) run metrics-only on all cores → DIR/results.jsonl and DIR/results.csv.
     /// An interrupted sweep resumes; `--shard I/N` runs points i ≡ I (mod N) (a Slurm array
@@ -272,6 +299,13 @@ fn run(command: Command) -> anyhow::Result<()> {
         Command::Shaping { scenario, out } => shaping::run_study(scenario.as_deref(), &out),
         Command::Distribution { scenario, at, out } => distribution::run(&scenario, &at, &out),
         Command::SpatialMoves { scenario, out } => spatial_moves::run(&scenario, &out),
+        Command::FlexError {
+            scenario,
+            bounds,
+            points,
+            elements,
+            out,
+        } => flex_error::run(&scenario, &bounds, points as usize, elements as usize, &out),
         Command::PrintStudy { out } => print_study::run(&out),
         Command::Plan {
             scenario,

@@ -161,6 +161,66 @@ fn hangprinter_move_on_lumped_lines_writes_its_cable_channels() {
     assert!(crossed, "no node crossed a pulley");
 }
 
+/// `cargo xtask flex-error` on the CoGiRo example's steel lines: a record per target whose error is
+/// the distance from its rest to its target, the Markdown table's largest error the record's,
+/// and a box given upside down refused before any file.
+#[test]
+fn flex_error_writes_a_consistent_record() {
+    let dir = TempDir::new("flex-error");
+    let out = dir.join("out");
+    let run = Command::new(env!("CARGO_BIN_EXE_xtask"))
+        .args([
+            "flex-error",
+            "--box=-4,4,-3,3,0.5,3.5",
+            "--points",
+            "2",
+            "--scenario",
+        ])
+        .arg(example("cogiro-lumped.toml"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let study: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("flex-error.json")).unwrap())
+            .unwrap();
+    let points = study["points"].as_array().unwrap();
+    assert_eq!(points.len(), 8);
+    let mut largest = 0.0f64;
+    for p in points {
+        let (rest, target) = (&p["rest"], &p["target"]);
+        let d = (0..3)
+            .map(|k| (rest[k].as_f64().unwrap() - target[k].as_f64().unwrap()).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!((d - p["error"].as_f64().unwrap()).abs() < 1e-15, "{p}");
+        assert!(d > 1e-5 && d < 1e-2, "a sag error of {d} m");
+        largest = largest.max(d);
+    }
+    assert_eq!(study["max"].as_f64().unwrap(), largest);
+    let table = std::fs::read_to_string(out.join("flex-error.md")).unwrap();
+    assert!(
+        table.contains(&format!("largest error {largest:.3e} m")),
+        "{table}"
+    );
+    let upside_down = dir.join("upside-down");
+    let refused = Command::new(env!("CARGO_BIN_EXE_xtask"))
+        .args(["flex-error", "--box=4,-4,-3,3,0.5,3.5", "--scenario"])
+        .arg(example("cogiro-lumped.toml"))
+        .arg("--out")
+        .arg(&upside_down)
+        .output()
+        .unwrap();
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("--box"));
+    assert!(!upside_down.exists());
+}
+
 /// Refused before any file: a reference the box cannot follow (named with time, pose, cable),
 /// a robot described for its statics only (no move), the FE cables in space, and lumped lines
 /// too short for the move, reeled into the workspace or on length reels.

@@ -30,7 +30,7 @@ use cdpr_core::robot::{Effector, MAX_CABLES, PerCable, Robot};
 use cdpr_core::scenario::Scenario;
 use nalgebra::Vector3;
 
-pub use statics::{Hang, hang};
+pub use statics::{Hang, hang, hang_with_length, rest_with_lengths};
 
 /// The scenario's cable as the spatial lumped model needs it.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -305,3 +305,146 @@ fn rest_state(
     model.set_stored(&stored);
     Ok(state)
 }
+
+/// Cable `cable` at rest from its pulley to the effector at `p` [m] holding `free` [m] of
+/// unstrained cable between them (a reel locked at that length): the reel tension T for which
+/// the hanging chain needs exactly `free`, to 1e-12 m. The length needed falls as T rises (a
+/// tauter line sags less and stretches more), so T is bracketed from the straight elastic
+/// line's tension and found by the Illinois secant; a tension too low for the modelled cable
+/// to hang at all lies below the root, and bisection steps over it.
+pub fn hang_with_length(
+    model: &LumpedSpatial,
+    cable: usize,
+    p: &Vector3<f64>,
+    free: f64,
+) -> Result<Hang, ModelError> {
+    let excess = |t: f64| hang(model, cable, p, t).map(|h| (h.free_length - free, h));
+    let ea = model.stiffness * model.segment;
+    let chord = (p - model.pulley(cable)).norm();
+    let weight = model.node_mass / model.segment * model.robot().gravity * free;
+    // Up from the straight line's tension (or the line's weight) until the line needs less
+    // than `free`; a tension too low to hang the line at all needs more.
+    let mut hi = (ea * (chord / free - 1.0)).max(weight).max(1e-6);
+    let mut f_hi = f64::INFINITY;
+    let mut last = None;
+    for _ in 0..200 {
+        if let Ok((f, h)) = excess(hi) {
+            (f_hi, last) = (f, Some(h));
+            if f < 0.0 {
+                break;
+            }
+        }
+        hi *= 2.0;
+    }
+    // Down from hi until the line needs more than `free`; where it cannot hang at all, halve
+    // the gap to the last tension that could.
+    let (mut lo, mut f_lo, mut floor) = (hi, f_hi, 0.0);
+    for _ in 0..400 {
+        if f_lo > 0.0 {
+            break;
+        }
+        let t = if floor > 0.0 {
+            0.5 * (floor + lo)
+        } else {
+            0.5 * lo
+        };
+        match excess(t) {
+            Ok((f, h)) if f > 0.0 => (lo, f_lo, last) = (t, f, Some(h)),
+            Ok((f, _)) => (hi, f_hi, lo, f_lo) = (t, f, t, f),
+            Err(_) => floor = t,
+        }
+    }
+    if !(f_lo > 0.0 && f_hi < 0.0) {
+        return Err(ModelError::State {
+            t: 0.0,
+            why: format!(
+                "cable {}: no tension hangs {free} m of unstrained line from its pulley to {:?} m",
+                cable + 1,
+                p.as_slice()
+            ),
+        });
+    }
+    let mut side = 0;
+    for _ in 0..200 {
+        let t = hi - f_hi * (hi - lo) / (f_hi - f_lo);
+        let (f, h) = excess(t)?;
+        if f.abs() <= 1e-12 || hi - lo <= 1e-14 * hi {
+            return Ok(h);
+        }
+        last = Some(h);
+        if f > 0.0 {
+            (lo, f_lo) = (t, f);
+            if side == 1 {
+                f_hi *= 0.5;
+            }
+            side = 1;
+        } else {
+            (hi, f_hi) = (t, f);
+            if side == -1 {
+                f_lo *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    last.ok_or_else(|| ModelError::State {
+        t: 0.0,
+        why: format!(
+            "cable {}: the locked length's tension did not converge",
+            cable + 1
+        ),
+    })
+}
+
+/// The robot at rest with every reel locked at the unstrained free lengths `lengths` [m]: the
+/// effector's pose (Newton on the effector's balance Σ f_i + M g⃗ = 0 from `guess`, central
+/// differences of 1e-7 m), each line hanging with its length, and the tensions at the reels.
+pub fn rest_with_lengths(
+    model: &LumpedSpatial,
+    guess: &Vector3<f64>,
+    lengths: &[f64],
+) -> Result<(Vector3<f64>, Vec<Hang>), ModelError> {
+    let m = model.robot().cables();
+    let lift = model.robot().effector_mass * model.robot().gravity;
+    let hangs = |p: &Vector3<f64>| -> Result<Vec<Hang>, ModelError> {
+        (0..m)
+            .map(|i| hang_with_length(model, i, p, lengths[i]))
+            .collect()
+    };
+    let residual = |hs: &[Hang]| {
+        hs.iter()
+            .fold(Vector3::new(0.0, 0.0, -lift), |f, h| f + h.pull)
+    };
+    let mut p = *guess;
+    let mut current = hangs(&p)?;
+    for _ in 0..50 {
+        let r = residual(&current);
+        let scale = lift + current.iter().map(|h| h.pull.norm()).sum::<f64>();
+        if r.norm() <= 1e-10 * scale {
+            return Ok((p, current));
+        }
+        let step = 1e-7;
+        let mut jacobian = Matrix3::zeros();
+        for k in 0..3 {
+            let e = Vector3::ith(k, step);
+            let plus = residual(&hangs(&(p + e))?);
+            let minus = residual(&hangs(&(p - e))?);
+            jacobian.set_column(k, &((plus - minus) / (2.0 * step)));
+        }
+        let delta = jacobian.try_inverse().ok_or_else(|| ModelError::State {
+            t: 0.0,
+            why: format!(
+                "locked reels: the effector's stiffness is singular at {:?} m",
+                p.as_slice()
+            ),
+        })? * r;
+        p -= delta;
+        current = hangs(&p)?;
+    }
+    Err(ModelError::State {
+        t: 0.0,
+        why: format!(
+            "locked reels at lengths {lengths:?} m: the effector's balance did not converge near {:?} m",
+            guess.as_slice()
+        ),
+    })
+}
