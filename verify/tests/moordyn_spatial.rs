@@ -11,6 +11,9 @@
 //! of N − 1 segments. MoorDyn lumps half of each segment's mass on its end nodes: the connector
 //! C_i (our P_1, mass μ l0) gets μ (l0 − a_i)/2 + μ l0/2 from the lines and μ a_i/2 as its own
 //! point mass; the effector gets μ l0/2 from each line, so its point mass is M − 4 μ l0/2.
+//!
+//! The same locked robot's effector modes are checked against the massless elastic lines'
+//! (MODELS.md §11) as the lines' mass vanishes.
 
 use cdpr_bench::core::model::{CableModel, PoseRule};
 use cdpr_bench::core::robot::distribution::{DistributionMethod, TensionBox, distribute};
@@ -82,12 +85,17 @@ fn geometry() -> ([Vector3<f64>; 4], Vector3<f64>) {
 /// The robot on lumped lines of unstrained length `length` each, at rest at its pose under the
 /// QP's tensions in [10, 70] N.
 fn at_rest(length: f64) -> (LumpedSpatial, Vec<f64>) {
+    at_rest_with(length, MU)
+}
+
+/// [`at_rest`] with lines of mass per length `mu` [kg/m].
+fn at_rest_with(length: f64, mu: f64) -> (LumpedSpatial, Vec<f64>) {
     let (anchors, p) = geometry();
     let robot = Robot::new(&anchors, 1.0, G).unwrap();
     let cable = CableProperties {
         elements: N,
         modelled_length: length,
-        mass_per_length: MU,
+        mass_per_length: mu,
         axial_stiffness: EA,
         axial_damping: 0.0,
     };
@@ -281,4 +289,120 @@ fn locked_reels_free_vibration_matches_moordyn() {
         error <= bound,
         "MoorDyn {error:e} m from ours; bound {bound:e} m"
     );
+}
+
+/// The lines' length for one stored node per line (the reel end, half a segment behind its
+/// pulley at most), from the free lengths of a rest on long lines.
+fn one_stored_node_length(mu: f64) -> f64 {
+    let (probe, state) = at_rest_with(3.0, mu);
+    let longest = (0..4)
+        .map(|c| probe.free_length(&state, c))
+        .fold(0.0, f64::max);
+    N as f64 * longest / (N as f64 - 0.5)
+}
+
+/// The effector's three mode frequencies [rad/s] of the locked robot at `rest` (lumped:
+/// K = −∂F/∂q from the model's own second-order form, the reel ends' coordinates dropped,
+/// K v = ω² M v; the effector's modes are those whose kinetic energy the effector holds most
+/// of), and the massless elastic lines' with the same reels locked at the same pose
+/// (MODELS.md §11: K = Σ (EA/L_i) u_i u_iᵀ + (T_i/l_i)(I − u_i u_iᵀ), L_i the locked line's
+/// whole unstrained length from its reel end, T_i the lumped line's tension at the effector).
+fn effector_modes(model: &LumpedSpatial, rest: &[f64]) -> ([f64; 3], [f64; 3]) {
+    use cdpr_bench::core::second_order::SecondOrderForm;
+    use nalgebra::{DMatrix, Matrix3, SymmetricEigen};
+    let mut form = model.clone();
+    let n = form.dofs();
+    let pattern = form.iteration_pattern();
+    let qdd = vec![0.0; n];
+    let (mut stiff, mut mass) = (vec![0.0; pattern.len()], vec![0.0; pattern.len()]);
+    form.iteration_matrix(rest, &qdd, &[0.0; 4], 0.0, 1.0, &mut stiff);
+    form.iteration_matrix(rest, &qdd, &[0.0; 4], 0.0, 0.0, &mut mass);
+    let mut k = DMatrix::<f64>::zeros(n, n);
+    let mut m = vec![0.0; n];
+    for (e, &(row, col)) in pattern.iter().enumerate() {
+        k[(row, col)] += stiff[e] - mass[e];
+        if row == col {
+            m[row] += mass[e];
+        }
+    }
+    let held: Vec<usize> = (0..4)
+        .flat_map(|c| (0..3).map(move |a| (c, a)))
+        .map(|(c, a)| model.index(c, 0, a))
+        .collect();
+    let keep: Vec<usize> = (0..n).filter(|i| !held.contains(i)).collect();
+    let scaled = DMatrix::from_fn(keep.len(), keep.len(), |r, c| {
+        let (i, j) = (keep[r], keep[c]);
+        k[(i, j)] / (m[i] * m[j]).sqrt()
+    });
+    let asymmetry = (&scaled - scaled.transpose()).amax();
+    assert!(
+        asymmetry <= 1e-9 * scaled.amax(),
+        "K not symmetric: {asymmetry:e}"
+    );
+    let eigen = SymmetricEigen::new((&scaled + scaled.transpose()) * 0.5);
+    let effector: Vec<usize> = (0..3)
+        .map(|a| {
+            keep.iter()
+                .position(|&i| i == model.index(0, N, a))
+                .unwrap()
+        })
+        .collect();
+    let mut ranked: Vec<(f64, f64)> = (0..keep.len())
+        .map(|k| {
+            let v = eigen.eigenvectors.column(k);
+            let share: f64 = effector.iter().map(|&i| v[i] * v[i]).sum();
+            (share, eigen.eigenvalues[k].max(0.0).sqrt())
+        })
+        .collect();
+    ranked.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mut lumped = [ranked[0].1, ranked[1].1, ranked[2].1];
+    lumped.sort_by(f64::total_cmp);
+    let p = model.effector(rest).position;
+    let mut k_elastic = Matrix3::<f64>::zeros();
+    for cable in 0..4 {
+        let d = model.pulley(cable) - p;
+        let (l, u) = (d.norm(), d.normalize());
+        let t = model.spring_force(rest, cable, N - 1);
+        let whole = N as f64 * model.segment;
+        k_elastic +=
+            u * u.transpose() * (EA / whole) + (Matrix3::identity() - u * u.transpose()) * (t / l);
+    }
+    let mass_effector = model.robot().effector_mass;
+    let mut elastic: Vec<f64> = k_elastic
+        .symmetric_eigenvalues()
+        .iter()
+        .map(|v| (v / mass_effector).sqrt())
+        .collect();
+    elastic.sort_by(f64::total_cmp);
+    (lumped, [elastic[0], elastic[1], elastic[2]])
+}
+
+/// The effector's modes on lumped lines with locked reels tend to the massless elastic lines'
+/// as the lines' mass goes to zero (MODELS.md §11's locked-reel stiffness), at first order: from
+/// μ/8 to μ/16 of the example's line the relative gap of each of the three modes halves (ratio
+/// within 0.45–0.55; measured 0.49 for all three, the ratios from μ down being 0.43, 0.47, 0.49,
+/// 0.49, 0.50 for the horizontal pair and 0.36, 0.44, 0.47, 0.49, 0.49 for the vertical mode, as
+/// a μ² part — Irvine's sag softening, (w l)² EA/(12 T³) ≈ 4e-4 here — fades), and on the
+/// example's line it is below 0.2 % (measured 0.12 % and 0.17 % at 122 and 133 rad/s).
+#[test]
+fn the_effector_modes_tend_to_the_elastic_lines_as_the_mass_vanishes() {
+    let gaps = |mu: f64| {
+        let length = one_stored_node_length(mu);
+        let (model, rest) = at_rest_with(length, mu);
+        assert_eq!(model.stored(), &[1, 1, 1, 1]);
+        let (lumped, elastic) = effector_modes(&model, &rest);
+        [0, 1, 2].map(|k| (lumped[k] - elastic[k]).abs() / elastic[k])
+    };
+    let example = gaps(MU);
+    let (coarse, fine) = (gaps(MU / 8.0), gaps(MU / 16.0));
+    for k in 0..3 {
+        assert!(example[k] < 2e-3, "mode {k}: {} relative", example[k]);
+        let ratio = fine[k] / coarse[k];
+        assert!(
+            (0.45..=0.55).contains(&ratio),
+            "mode {k}: gaps {} and {}",
+            coarse[k],
+            fine[k]
+        );
+    }
 }
