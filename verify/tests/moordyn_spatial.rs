@@ -13,7 +13,8 @@
 //! point mass; the effector gets μ l0/2 from each line, so its point mass is M − 4 μ l0/2.
 //!
 //! The same locked robot's effector modes are checked against the massless elastic lines'
-//! (MODELS.md §11) as the lines' mass vanishes.
+//! (MODELS.md §11) as the lines' mass vanishes, and a weightless robot's taut lines' transverse
+//! modes against the discrete string's closed form.
 
 use cdpr_bench::core::model::{CableModel, PoseRule};
 use cdpr_bench::core::robot::distribution::{DistributionMethod, TensionBox, distribute};
@@ -301,15 +302,17 @@ fn one_stored_node_length(mu: f64) -> f64 {
     N as f64 * longest / (N as f64 - 0.5)
 }
 
-/// The effector's three mode frequencies [rad/s] of the locked robot at `rest` (lumped:
-/// K = −∂F/∂q from the model's own second-order form, the reel ends' coordinates dropped,
-/// K v = ω² M v; the effector's modes are those whose kinetic energy the effector holds most
-/// of), and the massless elastic lines' with the same reels locked at the same pose
-/// (MODELS.md §11: K = Σ (EA/L_i) u_i u_iᵀ + (T_i/l_i)(I − u_i u_iᵀ), L_i the locked line's
-/// whole unstrained length from its reel end, T_i the lumped line's tension at the effector).
-fn effector_modes(model: &LumpedSpatial, rest: &[f64]) -> ([f64; 3], [f64; 3]) {
+/// The modes of `model` at `rest` with the coordinates `held` fixed: K = −∂F/∂q from the model's
+/// own second-order form (S(c_q = 1) − S(0)), M its diagonal, and the eigenpairs of
+/// M^(−1/2) K M^(−1/2) over the other coordinates (`keep`, the eigenvectors' row order). K must
+/// be symmetric (conservative springs, no stored node but the held ones) to 1e-9.
+fn modes_holding(
+    model: &LumpedSpatial,
+    rest: &[f64],
+    held: &[usize],
+) -> (nalgebra::SymmetricEigen<f64, nalgebra::Dyn>, Vec<usize>) {
     use cdpr_bench::core::second_order::SecondOrderForm;
-    use nalgebra::{DMatrix, Matrix3, SymmetricEigen};
+    use nalgebra::{DMatrix, SymmetricEigen};
     let mut form = model.clone();
     let n = form.dofs();
     let pattern = form.iteration_pattern();
@@ -325,10 +328,6 @@ fn effector_modes(model: &LumpedSpatial, rest: &[f64]) -> ([f64; 3], [f64; 3]) {
             m[row] += mass[e];
         }
     }
-    let held: Vec<usize> = (0..4)
-        .flat_map(|c| (0..3).map(move |a| (c, a)))
-        .map(|(c, a)| model.index(c, 0, a))
-        .collect();
     let keep: Vec<usize> = (0..n).filter(|i| !held.contains(i)).collect();
     let scaled = DMatrix::from_fn(keep.len(), keep.len(), |r, c| {
         let (i, j) = (keep[r], keep[c]);
@@ -339,7 +338,29 @@ fn effector_modes(model: &LumpedSpatial, rest: &[f64]) -> ([f64; 3], [f64; 3]) {
         asymmetry <= 1e-9 * scaled.amax(),
         "K not symmetric: {asymmetry:e}"
     );
-    let eigen = SymmetricEigen::new((&scaled + scaled.transpose()) * 0.5);
+    (
+        SymmetricEigen::new((&scaled + scaled.transpose()) * 0.5),
+        keep,
+    )
+}
+
+/// The reel ends' coordinates (locked reels hold them).
+fn reel_ends(model: &LumpedSpatial) -> Vec<usize> {
+    (0..4)
+        .flat_map(|c| (0..3).map(move |a| (c, a)))
+        .map(|(c, a)| model.index(c, 0, a))
+        .collect()
+}
+
+/// The effector's three mode frequencies [rad/s] of the locked robot at `rest` (lumped: the
+/// modes of [`modes_holding`] the reel ends, the effector's being those whose kinetic energy the
+/// effector holds most of), and the massless elastic lines' with the same reels locked at the
+/// same pose (MODELS.md §11: K = Σ (EA/L_i) u_i u_iᵀ + (T_i/l_i)(I − u_i u_iᵀ), L_i the locked
+/// line's whole unstrained length from its reel end, T_i the lumped line's tension at the
+/// effector).
+fn effector_modes(model: &LumpedSpatial, rest: &[f64]) -> ([f64; 3], [f64; 3]) {
+    use nalgebra::Matrix3;
+    let (eigen, keep) = modes_holding(model, rest, &reel_ends(model));
     let effector: Vec<usize> = (0..3)
         .map(|a| {
             keep.iter()
@@ -404,5 +425,64 @@ fn the_effector_modes_tend_to_the_elastic_lines_as_the_mass_vanishes() {
             coarse[k],
             fine[k]
         );
+    }
+}
+
+/// A taut line's transverse modes are the discrete string's closed form: a weightless robot
+/// (g = 0) with anchors on a regular tetrahedron (circumradius 1.5 m) around its effector, every
+/// line straight under the QP's 10 N, locked with its reel end at the pulley (a line as long as
+/// its free span, to 1e-9) and the effector held: each line is then N springs of stretched
+/// length d = l/N joining N − 1 masses m = μ l0 between fixed ends, whose transverse modes are
+/// ω_k = 2 √(T/(m d)) sin(kπ/(2N)), k = 1 … N − 1, each in two directions on each of the four
+/// lines (8 copies), all below the axial ones. The 8(N − 1) lowest frequencies of the model
+/// match them to 1e-9 (the eigen-solver's round-off; the geometric term T/λ is all that
+/// resists a transverse motion).
+#[test]
+fn a_taut_lines_transverse_modes_are_the_discrete_strings() {
+    let r = 1.5;
+    let (a, b) = ((8.0f64 / 9.0).sqrt(), (2.0f64 / 9.0).sqrt());
+    let c = (2.0f64 / 3.0).sqrt();
+    let anchors = [
+        Vector3::new(r * a, 0.0, -r / 3.0),
+        Vector3::new(-r * b, r * c, -r / 3.0),
+        Vector3::new(-r * b, -r * c, -r / 3.0),
+        Vector3::new(0.0, 0.0, r),
+    ];
+    let robot = Robot::new(&anchors, 1.0, 0.0).unwrap();
+    let tension = 10.0;
+    let free = r / (1.0 + tension / EA);
+    let cable = CableProperties {
+        elements: N,
+        modelled_length: free * (1.0 + 1e-9),
+        mass_per_length: MU,
+        axial_stiffness: EA,
+        axial_damping: 0.0,
+    };
+    let mut model = LumpedSpatial::new(robot, cable, &default_reel_directions(&anchors)).unwrap();
+    let p = Vector3::zeros();
+    let hold = cdpr_bench::core::robot::Tensions::from_fn(4, |_| tension);
+    let rest = model.equilibrium(&PoseRule::new(&p, hold)).unwrap().state;
+    assert_eq!(model.stored(), &[1, 1, 1, 1]);
+    let mut held = reel_ends(&model);
+    held.extend((0..3).map(|axis| model.index(0, N, axis)));
+    let (eigen, _) = modes_holding(&model, &rest, &held);
+    let mut omega: Vec<f64> = eigen
+        .eigenvalues
+        .iter()
+        .map(|v| v.max(0.0).sqrt())
+        .collect();
+    omega.sort_by(f64::total_cmp);
+    let (m, d) = (model.node_mass, r / N as f64);
+    for k in 1..N {
+        let expected = 2.0
+            * (tension / (m * d)).sqrt()
+            * (k as f64 * std::f64::consts::PI / (2.0 * N as f64)).sin();
+        for copy in 0..8 {
+            let got = omega[8 * (k - 1) + copy];
+            assert!(
+                (got - expected).abs() <= 1e-9 * expected,
+                "mode {k}, copy {copy}: {got} rad/s against {expected} rad/s"
+            );
+        }
     }
 }
