@@ -50,11 +50,16 @@ pub struct SpatialMetrics {
     /// The tensions at rest at the start [N].
     pub rest_tensions: Vec<f64>,
     pub move_end_s: f64,
+    /// Largest |E − E0 − W + D − ΣΔE| over the run [J]: the energy balance's residual, with the
+    /// reels' work W and the model's events (MODELS.md §4's audit).
+    pub energy_residual_max: f64,
+    /// Model events (massive lines: nodes passing a pulley; 0 for the elastic cables).
+    pub pulley_events: usize,
 }
 
 impl SpatialMetrics {
     /// The unit of each key that has one.
-    pub const UNITS: [(&'static str, &'static str); 10] = [
+    pub const UNITS: [(&'static str, &'static str); 11] = [
         ("path_err_max_move", "m"),
         ("path_err_max_transition", "m"),
         ("path_err_max_after_1s", "m"),
@@ -65,6 +70,7 @@ impl SpatialMetrics {
         ("saturated_s", "s"),
         ("reel_speed_max", "m/s"),
         ("rest_tensions", "N"),
+        ("energy_residual_max", "J"),
     ];
 
     /// The metrics of `run` (a spatial robot's: channels x, y, z, T1 … Tm, l0_1 … l0_m,
@@ -146,6 +152,10 @@ impl SpatialMetrics {
             reel_speed_max,
             rest_tensions: run.equilibrium.tensions.to_vec(),
             move_end_s: context.move_end,
+            energy_residual_max: column(Channel::EResidual)
+                .iter()
+                .fold(0.0, |m: f64, v| m.max(v.abs())),
+            pulley_events: run.events.len(),
         }
     }
 }

@@ -313,6 +313,10 @@ fn the_hangprinter_move_runs_on_lumped_lines_and_tends_to_elastic() {
         .unwrap();
     let worst = residual.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     assert!(!heavy.run.events.is_empty(), "no node crossed a pulley");
+    // The run's metrics carry the audit.
+    assert_eq!(heavy.metrics.energy_residual_max, worst);
+    assert_eq!(heavy.metrics.pulley_events, heavy.run.events.len());
+    assert_eq!(elastic.metrics.pulley_events, 0);
     assert!(worst < 1e-5, "energy balance residual {worst:e} J");
     let (gap_heavy, gap_light) = (path_gap(&heavy, &elastic), path_gap(&light, &elastic));
     let ratio = gap_light / gap_heavy;
