@@ -11,6 +11,8 @@
 //!   and the discrete-string closed forms;
 //! - a pendulum: a 1 kg mass on the cable released from 0.3 rad, MoorDyn against the lumped chain.
 
+mod common;
+
 use cdpr_bench::core::Vector2;
 use cdpr_bench::fe::element::Material;
 use cdpr_bench::fe::fixed_cable::FixedCable;
@@ -19,9 +21,6 @@ use cdpr_bench::lumped::spring_tension;
 use cdpr_bench::numerics::{Dopri5, Dopri5Options, OdeSystem};
 use cdpr_verify::irvine::Catenary;
 use serde_json::{Value, json};
-use std::io::Write;
-use std::path::Path;
-use std::process::{Command, Stdio};
 
 const EA: f64 = 179_520.0;
 const MU: f64 = 0.013816;
@@ -29,37 +28,7 @@ const G: f64 = 9.81;
 
 /// Runs `case` in MoorDyn (see `run_case.py` for its keys) and returns its answer.
 fn moordyn(case: Value) -> Value {
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/moordyn/run_case.py");
-    // The tests' own Python, with MoorDyn installed under target/ the first time.
-    let target = Path::new(env!("CARGO_TARGET_TMPDIR")).parent().unwrap();
-    let python = cdpr_testing::python::interpreter(target);
-    let mut child = Command::new(&python)
-        .arg(script)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap_or_else(|e| panic!("{}: {e}", python.display()));
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(case.to_string().as_bytes())
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        out.status.success(),
-        "MoorDyn case failed ({}): {}",
-        out.status,
-        stderr.lines().rev().take(15).collect::<Vec<_>>().join("\n")
-    );
-    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
-        panic!(
-            "MoorDyn's answer is not JSON ({e}); is moordyn installed for {}? {stderr}",
-            python.display()
-        )
-    })
+    common::moordyn("run_case.py", &case)
 }
 
 fn points(v: &Value) -> Vec<Vector2<f64>> {

@@ -16,6 +16,8 @@
 //! (MODELS.md §11) as the lines' mass vanishes, and a weightless robot's taut lines' transverse
 //! modes against the discrete string's closed form.
 
+mod common;
+
 use cdpr_bench::core::model::{CableModel, PoseRule};
 use cdpr_bench::core::robot::distribution::{DistributionMethod, TensionBox, distribute};
 use cdpr_bench::core::robot::{Robot, Vector};
@@ -23,9 +25,6 @@ use cdpr_bench::lumped::spatial::{CableProperties, LumpedSpatial, default_reel_d
 use cdpr_bench::numerics::{Dopri5, Dopri5Options, OdeSystem};
 use nalgebra::Vector3;
 use serde_json::{Value, json};
-use std::io::Write;
-use std::path::Path;
-use std::process::{Command, Stdio};
 
 /// Springs per line.
 const N: usize = 20;
@@ -38,31 +37,7 @@ const OFFSET: f64 = 2e-3;
 
 /// Runs `case` in MoorDyn (see `run_system.py`) and returns its answer.
 fn moordyn(case: &Value) -> Value {
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/moordyn/run_system.py");
-    let target = Path::new(env!("CARGO_TARGET_TMPDIR")).parent().unwrap();
-    let python = cdpr_testing::python::interpreter(target);
-    let mut child = Command::new(&python)
-        .arg(script)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap_or_else(|e| panic!("{}: {e}", python.display()));
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(case.to_string().as_bytes())
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        out.status.success(),
-        "MoorDyn failed ({}): {}",
-        out.status,
-        stderr.lines().rev().take(15).collect::<Vec<_>>().join("\n")
-    );
-    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("not JSON ({e}): {stderr}"))
+    common::moordyn("run_system.py", case)
 }
 
 /// Anchors [m]: three low at 120° on a 1.5 m circle at z = 0 and one 2.3 m above the centre,

@@ -25,6 +25,22 @@ fn xtask(args: &[&str], scenario: &Path, out: &Path) -> Output {
         .unwrap()
 }
 
+/// `out/timeseries.csv`: the channels' names (units stripped) and the rows.
+fn timeseries(out: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
+    let mut lines = text.lines();
+    let names = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|h| h.split(" [").next().unwrap().to_owned())
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (names, rows)
+}
+
 /// The Hangprinter example's move: every sample's tensions pull the effector with W T, W from
 /// the anchors here, the effector's own acceleration M p̈ + M g (second differences of the
 /// samples, O(Δt²) with the dense output's interpolation: 1.9e-5 N seen, 1e-4 N allowed, of
@@ -49,17 +65,7 @@ fn hangprinter_move_writes_a_consistent_record() {
         assert!(bytes > 1000, "{figure}: {bytes} B");
     }
     assert!(metrics["path_err_max_move"].as_f64().unwrap() < 1e-6);
-    let text = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
-    let mut lines = text.lines();
-    let names: Vec<&str> = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(|h| h.split(" [").next().unwrap())
-        .collect();
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
+    let (names, rows) = timeseries(&out);
     let col = |name: &str| names.iter().position(|n| *n == name).unwrap();
     let anchors = [
         [0.0, -1.61098, -0.13153],
@@ -120,17 +126,7 @@ fn hangprinter_move_on_lumped_lines_writes_its_cable_channels() {
     let metrics: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
     assert_eq!(metrics["status"], "complete");
-    let text = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
-    let mut lines = text.lines();
-    let names: Vec<String> = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(|h| h.split(" [").next().unwrap().to_owned())
-        .collect();
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
+    let (names, rows) = timeseries(&out);
     let column = |name: &str| {
         let k = names
             .iter()

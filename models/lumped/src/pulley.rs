@@ -72,6 +72,30 @@ fn smallest(x: &[f64], f: impl Fn(f64) -> f64) -> f64 {
     lanes.into_iter().fold(tail, f64::min)
 }
 
+/// The run's stop when `cable`'s last stored node would leave the reel at `t` [s].
+pub(crate) fn paid_out(t: f64, cable: usize) -> ModelError {
+    ModelError::State {
+        t,
+        why: format!(
+            "cable {} is paid out to its reel end: lengthen cable.modelled_length",
+            cable + 1
+        ),
+    }
+}
+
+/// The run's stop when a node of `cable` other than the boundary ones passes its pulley at `t`
+/// [s] (`stored` nodes on the reel).
+pub(crate) fn out_of_order(t: f64, cable: usize, stored: usize) -> ModelError {
+    ModelError::State {
+        t,
+        why: format!(
+            "cable {}: a node passed the pulley out of order (stored nodes must be 0..{stored}); \
+             the lumped model's pulley rule does not hold",
+            cable + 1
+        ),
+    }
+}
+
 /// Applies event `index` at `t` (see the module documentation).
 pub(crate) fn apply_event(
     model: &mut Lumped,
@@ -88,13 +112,7 @@ pub(crate) fn apply_event(
     let (j, what) = match kind {
         0 => {
             if r == 1 {
-                return Err(ModelError::State {
-                    t,
-                    why: format!(
-                        "cable {} is paid out to its reel end: lengthen cable.modelled_length",
-                        cable + 1
-                    ),
-                });
+                return Err(paid_out(t, cable));
             }
             let j = r - 1;
             y[model.x_index(cable, j)] = pulley - PULLEY_OFFSET * TOWARD_REEL[cable];
@@ -110,16 +128,7 @@ pub(crate) fn apply_event(
             stored[cable] = r + 1;
             (j, "is reeled in")
         }
-        _ => {
-            return Err(ModelError::State {
-                t,
-                why: format!(
-                    "cable {}: a node passed the pulley out of order (stored nodes must be 0..{r}); \
-                     the lumped model's pulley rule does not hold",
-                    cable + 1
-                ),
-            });
-        }
+        _ => return Err(out_of_order(t, cable, r)),
     };
     model.set_stored(stored);
     Ok(ModelEvent {

@@ -77,13 +77,7 @@ pub(super) fn apply_event(
     let (j, what) = match kind {
         0 => {
             if r == 1 {
-                return Err(ModelError::State {
-                    t,
-                    why: format!(
-                        "cable {} is paid out to its reel end: lengthen cable.modelled_length",
-                        cable + 1
-                    ),
-                });
+                return Err(crate::pulley::paid_out(t, cable));
             }
             let j = r - 1;
             let v = model.node_velocity(y, cable, j);
@@ -105,16 +99,7 @@ pub(super) fn apply_event(
             stored[cable] = r + 1;
             (j, "is reeled in")
         }
-        _ => {
-            return Err(ModelError::State {
-                t,
-                why: format!(
-                    "cable {}: a node passed the pulley out of order (stored nodes must be 0..{r}); \
-                     the lumped model's pulley rule does not hold",
-                    cable + 1
-                ),
-            });
-        }
+        _ => return Err(crate::pulley::out_of_order(t, cable, r)),
     };
     model.set_stored(&stored);
     Ok(ModelEvent {
