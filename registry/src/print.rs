@@ -3,7 +3,9 @@
 //! shaped per axis ([`PrintPath`]), checked for wrench feasibility, run through the robot's
 //! cable model and controller, and measured by its contour error ([`ContourMetrics`]).
 
-use crate::spatial::{check_feasible, loop_of, spatial_robot};
+use crate::config::ModelConfig;
+use crate::kind::ModelKind;
+use crate::spatial::{check_feasible, loop_of, lumped_model, run_robot};
 use crate::study::Error;
 use cdpr_analysis::contour::ContourMetrics;
 pub use cdpr_analysis::spatial::positions;
@@ -50,7 +52,7 @@ pub fn prepare_print(
     gcode_text: &str,
     layers: Option<RangeInclusive<usize>>,
 ) -> Result<PreparedPrint, Error> {
-    let robot = spatial_robot(scenario)?;
+    let (robot, kind) = run_robot(scenario)?;
     let printer = scenario.printer.clone().unwrap_or_default();
     let (program, layers, selected) = plan_layers(scenario, gcode_text, layers)?;
     let shapers = axis_shapers(&printer)?;
@@ -62,6 +64,15 @@ pub fn prepare_print(
         let [p, _, a] = path.reference(t, true);
         (p, a)
     })?;
+    if kind == ModelKind::Lumped {
+        // Lumped lines must reach every pose of the path from their reels.
+        let poses: Vec<_> = (0..=n)
+            .map(|k| path.reference(k as f64 / rate, false)[0])
+            .collect();
+        let t_max = scenario.controller.t_max.unwrap_or(0.0);
+        lumped_model(scenario, &ModelConfig::from_scenario(scenario)?)?
+            .check_poses(&poses, t_max)?;
+    }
     Ok(PreparedPrint {
         program,
         layers,
@@ -145,7 +156,22 @@ pub fn simulate_print(
     print: &PreparedPrint,
     observer: &mut Observer,
 ) -> Result<PrintRun, Error> {
-    let mut sys = loop_of(scenario, spatial_robot(scenario)?)?;
+    let (robot, kind) = run_robot(scenario)?;
+    if kind == ModelKind::Lumped {
+        let model = lumped_model(scenario, &ModelConfig::from_scenario(scenario)?)?;
+        let sys = cdpr_core::closed_loop::ClosedLoop::new(model, scenario)?;
+        return print_on(scenario, print, sys, observer);
+    }
+    print_on(scenario, print, loop_of(scenario, robot)?, observer)
+}
+
+/// Runs the print on the loop `sys` and measures it.
+fn print_on<M: cdpr_core::model::CableModel<3>>(
+    scenario: &Scenario,
+    print: &PreparedPrint,
+    mut sys: cdpr_core::closed_loop::ClosedLoop<M, 3>,
+    observer: &mut Observer,
+) -> Result<PrintRun, Error> {
     sys.path = Some(Path::Print(print.path.clone()));
     let options = print_options(scenario, print);
     let run = simulate_observed_reusing(&mut sys, &options, SeriesBuffer::default(), observer)?;

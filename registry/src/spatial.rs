@@ -63,17 +63,17 @@ pub fn prepare_spatial(scenario: &Scenario) -> Result<Robot<3>, Error> {
     Ok(robot)
 }
 
-/// The scenario's spatial robot with its model checked, for the studies and the printing path,
-/// which run the massless elastic cables (a massive model is refused by name) — what a statics
-/// or modes study needs, without the move.
+/// The scenario's spatial robot with its model checked, for the studies that run the massless
+/// elastic cables (a massive model is refused by name) — what a statics or modes study needs,
+/// without the move.
 pub fn spatial_robot(scenario: &Scenario) -> Result<Robot<3>, Error> {
     let (robot, kind) = run_robot(scenario)?;
     if kind != ModelKind::Elastic {
         return Err(out_of_range(
             "model.kind",
             format!("\"{kind}\" with robot.anchors"),
-            "\"elastic\" for this study or print (the lumped cables in space run `simulate` \
-             moves so far)",
+            "\"elastic\" for this study (the lumped cables in space run `simulate` moves and \
+             prints so far)",
         )
         .into());
     }
@@ -82,8 +82,8 @@ pub fn spatial_robot(scenario: &Scenario) -> Result<Robot<3>, Error> {
 
 /// The scenario's spatial robot and the cable model its move runs, checked: the massless elastic
 /// cables, or the lumped ones (MODELS.md §4 in space) under a tension controller — the length
-/// reels and printing on lumped cables are refused by name.
-fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Error> {
+/// reels on lumped cables are refused by name.
+pub(crate) fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Error> {
     let robot = scenario.spatial_robot().ok_or_else(|| {
         out_of_range(
             "robot.anchors",
@@ -110,8 +110,7 @@ fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Error> {
     Ok((robot, config.kind))
 }
 
-/// What the spatial lumped cables run so far: three or more cables, tension reels, a move (not a
-/// print).
+/// What the spatial lumped cables run so far: three or more cables on tension reels.
 fn check_lumped(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
     use cdpr_core::scenario::ControllerKind;
     let refuse = |key: &'static str, value: String, allowed: &str| -> Result<(), Error> {
@@ -131,18 +130,14 @@ fn check_lumped(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
             "a tension controller: reels driven by length on massive cables are not built yet",
         );
     }
-    if scenario.printer.is_some() {
-        return refuse(
-            "printer",
-            "a print with model.kind = \"lumped\"".into(),
-            "absent: prints run the elastic cables so far",
-        );
-    }
     Ok(())
 }
 
 /// The spatial lumped model of `scenario` (its `[model] elements`).
-fn lumped_model(scenario: &Scenario, config: &ModelConfig) -> Result<LumpedSpatial, Error> {
+pub(crate) fn lumped_model(
+    scenario: &Scenario,
+    config: &ModelConfig,
+) -> Result<LumpedSpatial, Error> {
     Ok(LumpedSpatial::from_scenario(
         scenario,
         config.lumped()?.elements,

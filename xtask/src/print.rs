@@ -285,18 +285,15 @@ fn list_skipped(program: &gcode::Program) {
 
 /// Where the print's channels sit in the run's row.
 fn columns(scenario: &Scenario) -> Result<(Columns, usize)> {
-    let robot = cdpr_bench::spatial_robot(scenario)?;
-    let model = cdpr_bench::elastic::Elastic::new(robot, scenario.cable.axial_stiffness());
-    let names = cdpr_bench::core::runner::channel_names(&model);
+    let cables = scenario.spatial_robot().map_or(0, |r| r.cables());
+    let (names, _) = cdpr_bench::spatial_channel_headings(scenario)?;
     let index = |name: &str| names.iter().position(|n| n == name).expect("channel");
     let columns = Columns {
         t: index(&Channel::Time.name()),
         xyz: [Channel::X, Channel::Y, Channel::Z].map(|c| index(&c.name())),
-        tensions: (1..=robot.cables())
-            .map(|i| index(&format!("T{i}")))
-            .collect(),
+        tensions: (1..=cables).map(|i| index(&format!("T{i}"))).collect(),
     };
-    Ok((columns, robot.cables()))
+    Ok((columns, cables))
 }
 
 /// How a print ended: what it computed (all, or what a failed or interrupted run sampled),

@@ -200,28 +200,35 @@ impl LumpedSpatial {
         };
         let model = Self::new(robot, cable, &reels)?;
         if let Ok((start, end)) = scenario.trajectory.spatial_move() {
-            model.check_free_side(&[Vector3::from(start), Vector3::from(end)])?;
-            let chord = [start, end]
-                .iter()
-                .flat_map(|p| {
-                    let p = Vector3::from(*p);
-                    robot.anchors().iter().map(move |a| (a - p).norm())
-                })
-                .fold(0.0, f64::max);
-            let stretch = 1.0 + scenario.controller.t_max.unwrap_or(0.0) / cable.axial_stiffness;
-            let needed = 1.05 * stretch * chord + 2.0 * model.segment;
-            if cable.modelled_length < needed {
-                return Err(ModelError::Parameter {
-                    name: "cable.modelled_length",
-                    value: cable.modelled_length,
-                    allowed: format!(
-                        "≥ {needed:.6} m for this move (1.05 × (1 + t_max/EA) × longest chord \
-                         {chord:.6} m, plus two spare stored elements)"
-                    ),
-                });
-            }
+            let t_max = scenario.controller.t_max.unwrap_or(0.0);
+            model.check_poses(&[Vector3::from(start), Vector3::from(end)], t_max)?;
         }
         Ok(model)
+    }
+
+    /// The lines fit every one of `poses` [m] (a move's ends, or a print's sampled path): each
+    /// pose on every pulley's free side ([`Self::check_free_side`]), and the modelled length at
+    /// least 1.05 (1 + t_max/EA) times the longest chord plus two spare stored elements.
+    pub fn check_poses(&self, poses: &[Vector3<f64>], t_max: f64) -> Result<(), ModelError> {
+        self.check_free_side(poses)?;
+        let chord = poses
+            .iter()
+            .flat_map(|p| self.robot.anchors().iter().map(move |a| (a - p).norm()))
+            .fold(0.0, f64::max);
+        let ea = self.stiffness * self.segment;
+        let length = self.segment * self.elements as f64;
+        let needed = 1.05 * (1.0 + t_max / ea) * chord + 2.0 * self.segment;
+        if length < needed {
+            return Err(ModelError::Parameter {
+                name: "cable.modelled_length",
+                value: length,
+                allowed: format!(
+                    "≥ {needed:.6} m for this path (1.05 × (1 + t_max/EA) × longest chord \
+                     {chord:.6} m, plus two spare stored elements)"
+                ),
+            });
+        }
+        Ok(())
     }
 
     /// Each of `poses` [m] on the free side of every cable's pulley ((p − A_i)·r_i < 0 by more
