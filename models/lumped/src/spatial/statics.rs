@@ -134,6 +134,15 @@ pub fn hang(
     p: &Vector3<f64>,
     tension: f64,
 ) -> Result<Hang, ModelError> {
+    if !(tension > 0.0) {
+        return Err(ModelError::State {
+            t: 0.0,
+            why: format!(
+                "cable {}: a reel tension of {tension} N cannot hang a line (it must be > 0 N)",
+                cable + 1
+            ),
+        });
+    }
     let (n, l0) = (model.elements, model.segment);
     let pulley = model.pulley(cable);
     let chord = p - pulley;
