@@ -134,7 +134,7 @@ pub fn hang(
     p: &Vector3<f64>,
     tension: f64,
 ) -> Result<Hang, ModelError> {
-    if !(tension > 0.0) {
+    if tension <= 0.0 || tension.is_nan() {
         return Err(ModelError::State {
             t: 0.0,
             why: format!(
