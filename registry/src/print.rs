@@ -5,11 +5,12 @@
 
 use crate::config::ModelConfig;
 use crate::kind::ModelKind;
-use crate::spatial::{check_feasible, loop_of, lumped_model, run_robot};
+use crate::spatial::{SpatialVisitor, check_feasible, lumped_model, run_robot, with_spatial_model};
 use crate::study::Error;
 use cdpr_analysis::contour::ContourMetrics;
 pub use cdpr_analysis::spatial::positions;
-use cdpr_core::closed_loop::Path;
+use cdpr_core::closed_loop::{ClosedLoop, Path};
+use cdpr_core::model::CableModel;
 use cdpr_core::print_path::{AxisShaper, PrintPath};
 use cdpr_core::runner::{Observer, Run, RunOptions, simulate_observed_reusing};
 use cdpr_core::scenario::{Designed, Printer, Scenario, out_of_range};
@@ -156,27 +157,31 @@ pub fn simulate_print(
     print: &PreparedPrint,
     observer: &mut Observer,
 ) -> Result<PrintRun, Error> {
-    let (robot, kind) = run_robot(scenario)?;
-    if kind == ModelKind::Lumped {
-        let model = lumped_model(scenario, &ModelConfig::from_scenario(scenario)?)?;
-        let sys = cdpr_core::closed_loop::ClosedLoop::new(model, scenario)?;
-        return print_on(scenario, print, sys, observer);
+    struct Print<'s, 'o, 'p> {
+        scenario: &'s Scenario,
+        print: &'s PreparedPrint,
+        observer: &'o mut Observer<'p>,
     }
-    print_on(scenario, print, loop_of(scenario, robot)?, observer)
-}
-
-/// Runs the print on the loop `sys` and measures it.
-fn print_on<M: cdpr_core::model::CableModel<3>>(
-    scenario: &Scenario,
-    print: &PreparedPrint,
-    mut sys: cdpr_core::closed_loop::ClosedLoop<M, 3>,
-    observer: &mut Observer,
-) -> Result<PrintRun, Error> {
-    sys.path = Some(Path::Print(print.path.clone()));
-    let options = print_options(scenario, print);
-    let run = simulate_observed_reusing(&mut sys, &options, SeriesBuffer::default(), observer)?;
-    let contour = contour_of(print, &run);
-    Ok(PrintRun { run, contour })
+    impl SpatialVisitor for Print<'_, '_, '_> {
+        type Output = PrintRun;
+        fn visit<M: CableModel<3>>(self, model: M) -> Result<PrintRun, Error> {
+            let mut sys = ClosedLoop::new(model, self.scenario)?;
+            sys.path = Some(Path::Print(self.print.path.clone()));
+            let options = print_options(self.scenario, self.print);
+            let buffer = SeriesBuffer::default();
+            let run = simulate_observed_reusing(&mut sys, &options, buffer, self.observer)?;
+            let contour = contour_of(self.print, &run);
+            Ok(PrintRun { run, contour })
+        }
+    }
+    with_spatial_model(
+        scenario,
+        Print {
+            scenario,
+            print,
+            observer,
+        },
+    )
 }
 
 /// The contour metrics of `run` (or of the part a failed run sampled).

@@ -9,7 +9,7 @@ use crate::kind::ModelKind;
 use crate::study::Error;
 use cdpr_analysis::spatial::{SpatialContext, SpatialMetrics};
 use cdpr_core::closed_loop::ClosedLoop;
-use cdpr_core::model::ModelParams;
+use cdpr_core::model::{CableModel, ModelParams};
 use cdpr_core::robot::distribution::{
     BOX_TOLERANCE, Bound, DistributionMethod, TensionBox, distribute,
 };
@@ -247,36 +247,60 @@ pub fn simulate_spatial(scenario: &Scenario, observer: &mut Observer) -> Result<
     simulate_spatial_into(scenario, observer, SeriesBuffer::default())
 }
 
+/// Generic work on a spatial scenario's cable model, monomorphised for each (as the planar
+/// [`crate::ModelVisitor`]).
+pub(crate) trait SpatialVisitor {
+    type Output;
+    fn visit<M: CableModel<3>>(self, model: M) -> Result<Self::Output, Error>;
+}
+
+/// The scenario's spatial cable model, checked and built, handed to `visitor`: the kind is
+/// matched here and nowhere else.
+pub(crate) fn with_spatial_model<V: SpatialVisitor>(
+    scenario: &Scenario,
+    visitor: V,
+) -> Result<V::Output, Error> {
+    let (robot, kind) = run_robot(scenario)?;
+    if kind == ModelKind::Lumped {
+        visitor.visit(lumped_model(
+            scenario,
+            &ModelConfig::from_scenario(scenario)?,
+        )?)
+    } else {
+        visitor.visit(Elastic::new(robot, scenario.cable.axial_stiffness()))
+    }
+}
+
 /// As [`simulate_spatial`], the samples written into `buffer`'s memory (a sweep's worker).
 pub fn simulate_spatial_into(
     scenario: &Scenario,
     observer: &mut Observer,
     buffer: SeriesBuffer,
 ) -> Result<SpatialRun, Error> {
-    let robot = prepare_spatial(scenario)?;
-    if is_lumped(scenario)? {
-        let config = ModelConfig::from_scenario(scenario)?;
-        let sys = ClosedLoop::new(lumped_model(scenario, &config)?, scenario)?;
-        return run_loop(scenario, sys, observer, buffer);
+    struct Simulate<'s, 'o, 'p> {
+        scenario: &'s Scenario,
+        observer: &'o mut Observer<'p>,
+        buffer: SeriesBuffer,
     }
-    run_loop(scenario, loop_of(scenario, robot)?, observer, buffer)
-}
-
-/// Runs the loop `sys` of `scenario` and measures it.
-fn run_loop<M: cdpr_core::model::CableModel<3>>(
-    scenario: &Scenario,
-    mut sys: ClosedLoop<M, 3>,
-    observer: &mut Observer,
-    buffer: SeriesBuffer,
-) -> Result<SpatialRun, Error> {
-    let run = simulate_observed_reusing(&mut sys, &RunOptions::from(scenario), buffer, observer)?;
-    let metrics = spatial_metrics(scenario, &sys, &run);
-    Ok(SpatialRun { run, metrics })
-}
-
-/// Whether the scenario's spatial run is on lumped cables.
-fn is_lumped(scenario: &Scenario) -> Result<bool, Error> {
-    Ok(ModelConfig::from_scenario(scenario)?.kind == ModelKind::Lumped)
+    impl SpatialVisitor for Simulate<'_, '_, '_> {
+        type Output = SpatialRun;
+        fn visit<M: CableModel<3>>(self, model: M) -> Result<SpatialRun, Error> {
+            let mut sys = ClosedLoop::new(model, self.scenario)?;
+            let options = RunOptions::from(self.scenario);
+            let run = simulate_observed_reusing(&mut sys, &options, self.buffer, self.observer)?;
+            let metrics = spatial_metrics(self.scenario, &sys, &run);
+            Ok(SpatialRun { run, metrics })
+        }
+    }
+    prepare_spatial(scenario)?;
+    with_spatial_model(
+        scenario,
+        Simulate {
+            scenario,
+            observer,
+            buffer,
+        },
+    )
 }
 
 /// The closed loop of `robot` under `scenario`, the reference not checked again.
@@ -303,14 +327,16 @@ pub fn spatial_metrics_of(scenario: &Scenario, run: &Run) -> Result<SpatialMetri
 /// brought to rest at the start (a controller that cannot be designed, or a start the tensions
 /// do not hold, is refused here).
 pub fn prepare_spatial_start(scenario: &Scenario) -> Result<(), Error> {
-    let robot = prepare_spatial(scenario)?;
-    if is_lumped(scenario)? {
-        let config = ModelConfig::from_scenario(scenario)?;
-        ClosedLoop::new(lumped_model(scenario, &config)?, scenario)?.initial_state()?;
-    } else {
-        loop_of(scenario, robot)?.initial_state()?;
+    struct Start<'s>(&'s Scenario);
+    impl SpatialVisitor for Start<'_> {
+        type Output = ();
+        fn visit<M: CableModel<3>>(self, model: M) -> Result<(), Error> {
+            ClosedLoop::new(model, self.0)?.initial_state()?;
+            Ok(())
+        }
     }
-    Ok(())
+    prepare_spatial(scenario)?;
+    with_spatial_model(scenario, Start(scenario))
 }
 
 /// The number of channels of a spatial scenario's run.
@@ -323,19 +349,19 @@ pub fn spatial_channels(scenario: &Scenario) -> Result<usize, Error> {
 pub fn spatial_channel_headings(
     scenario: &Scenario,
 ) -> Result<(Vec<String>, Vec<&'static str>), Error> {
-    use cdpr_core::runner::{channel_names, channel_units};
-    let (robot, kind) = run_robot(scenario)?;
-    Ok(if kind == ModelKind::Lumped {
-        let model = lumped_model(scenario, &ModelConfig::from_scenario(scenario)?)?;
-        (channel_names(&model), channel_units(&model))
-    } else {
-        let model = Elastic::new(robot, scenario.cable.axial_stiffness());
-        (channel_names(&model), channel_units(&model))
-    })
+    struct Headings;
+    impl SpatialVisitor for Headings {
+        type Output = (Vec<String>, Vec<&'static str>);
+        fn visit<M: CableModel<3>>(self, model: M) -> Result<Self::Output, Error> {
+            use cdpr_core::runner::{channel_names, channel_units};
+            Ok((channel_names(&model), channel_units(&model)))
+        }
+    }
+    with_spatial_model(scenario, Headings)
 }
 
 /// The metrics of a spatial run of `scenario` on the loop `sys`.
-pub fn spatial_metrics<M: cdpr_core::model::CableModel<3>>(
+pub fn spatial_metrics<M: CableModel<3>>(
     scenario: &Scenario,
     sys: &ClosedLoop<M, 3>,
     run: &Run,

@@ -18,6 +18,7 @@ pub mod fixed_cable;
 mod implicit;
 mod modal;
 pub mod params;
+mod path;
 mod pulley;
 pub mod spatial;
 mod statics;
@@ -195,13 +196,10 @@ impl Lumped {
     /// (per sample, where the full version was a third of the lumped implicit run).
     #[inline]
     pub fn spring_length(&self, y: &[f64], cable: usize, j: usize) -> f64 {
-        let (a, b) = (self.node(y, cable, j), self.node(y, cable, j + 1));
-        if j + 1 == self.stored[cable] {
-            let pulley = self.pulley(cable);
-            (pulley - a).norm() + (pulley - b).norm()
-        } else {
-            (b - a).norm()
-        }
+        crate::path::path_length(
+            (self.node(y, cable, j), self.node(y, cable, j + 1)),
+            (j + 1 == self.stored[cable]).then(|| self.pulley(cable)),
+        )
     }
 
     /// Length λ_j of spring j of `cable` along the cable path, its rate λ̇_j, and the unit vectors
@@ -209,28 +207,14 @@ impl Lumped {
     /// (eq. 4): λ = |P_{r−1} A| + |A P_r|, pulling both ends towards A.
     #[inline]
     fn spring(&self, y: &[f64], cable: usize, j: usize) -> (f64, f64, Vector2<f64>, Vector2<f64>) {
-        let (a, b) = (self.node(y, cable, j), self.node(y, cable, j + 1));
-        let (va, vb) = (
-            self.node_velocity(y, cable, j),
-            self.node_velocity(y, cable, j + 1),
-        );
-        if j + 1 == self.stored[cable] {
-            let pulley = self.pulley(cable);
-            let (da, db) = (pulley - a, pulley - b);
-            let (la, lb) = (da.norm(), db.norm());
-            // A node exactly at the pulley has no direction towards it; the limit of the path is
-            // the direction to the spring's other end (a light cable can drive a node there).
-            let toward = |d: Vector2<f64>, l: f64, other: Vector2<f64>| {
-                if l > 0.0 { d / l } else { other.normalize() }
-            };
-            let (ua, ub) = (toward(da, la, b - a), toward(db, lb, a - b));
-            (la + lb, -ua.dot(&va) - ub.dot(&vb), ua, ub)
-        } else {
-            let d = b - a;
-            let l = d.norm();
-            let u = d / l;
-            (l, u.dot(&(vb - va)), u, -u)
-        }
+        path::spring_path(
+            (self.node(y, cable, j), self.node(y, cable, j + 1)),
+            (
+                self.node_velocity(y, cable, j),
+                self.node_velocity(y, cable, j + 1),
+            ),
+            (j + 1 == self.stored[cable]).then(|| self.pulley(cable)),
+        )
     }
 
     /// Net forces on every position coordinate [N] (gravity included; stored nodes' vertical

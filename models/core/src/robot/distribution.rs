@@ -216,8 +216,8 @@ fn inside(t: &Tensions, limits: TensionBox) -> bool {
 fn full_gram_inverse<const D: usize>(
     w: &StructureMatrix<D>,
 ) -> Result<Matrix<D>, DistributionError> {
-    let all = [true; MAX_CABLES];
-    gram_inverse(w, &all[..w.columns().len()]).ok_or(DistributionError::RankDeficient { axes: D })
+    w.gram_inverse()
+        .ok_or(DistributionError::RankDeficient { axes: D })
 }
 
 /// The closed form on the free cables: T_i = T_m − u_iᵀ λ with (W_F W_Fᵀ) λ = W_F T_m − w

@@ -110,6 +110,12 @@ impl<const D: usize> StructureMatrix<D> {
         terms.fold(u * *t0, |f, (u, t)| f + u * *t)
     }
 
+    /// (W Wᵀ)⁻¹, through which W⁺ = Wᵀ (W Wᵀ)⁻¹ maps a wrench to its least-norm tensions; None
+    /// when the cables span fewer than D directions.
+    pub fn gram_inverse(&self) -> Option<Matrix<D>> {
+        gram::gram_inverse(self, &[true; MAX_CABLES][..self.cables])
+    }
+
     /// W as a D × D matrix, for robots with as many cables as axes (None otherwise).
     pub fn square(&self) -> Option<Matrix<D>> {
         (self.cables == D).then(|| Matrix::from_fn(|r, c| self.columns[c][r]))

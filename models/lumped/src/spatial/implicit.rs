@@ -1,9 +1,9 @@
 //! The spatial lumped model's second-order form for the implicit integrator (MODELS.md §6):
 //! R = diag(m) q'' − F(q, q', T), F the forces of the right-hand side (a stored node's force
 //! projected on its reel line r_i, so its rows across the line read m q''_⊥ = 0 and it stays on
-//! the line; a locked reel end's rows read m q'' = 0). The iteration matrix is diag(m) plus the
-//! springs' analytic tangent stiffness for undamped cables, coloured central differences for
-//! damped ones. Its pattern is the chains': each node's 3 × 3 block couples only to its two
+//! the line; a locked reel end has none, so its rows read m q'' = 0). The iteration matrix is
+//! diag(m) plus the springs' analytic tangent stiffness for undamped cables, coloured central
+//! differences for damped ones. Its pattern is the chains': each node's 3 × 3 block couples only to its two
 //! neighbours along its cable (the straddling spring's ends are neighbours too), the effector to
 //! the last node of every cable — the star of m arms meeting at the effector. The pattern does
 //! not depend on which nodes are stored, so pulley events never change it.
@@ -146,13 +146,6 @@ impl LumpedSpatial {
         let mut f = std::mem::take(&mut self.implicit.forces);
         f.resize(np, 0.0);
         self.forces(state, tensions, &mut f);
-        if self.locked {
-            for cable in 0..self.robot().cables() {
-                for axis in 0..3 {
-                    f[self.index(cable, 0, axis)] = 0.0;
-                }
-            }
-        }
         let cables = np - 3;
         let m = self.node_mass;
         for i in 0..cables {

@@ -86,7 +86,7 @@ pub struct LumpedSpatial {
 /// horizontal reel line there would put the anchor's own plumb line on the boundary of the
 /// pulley's side rule.
 pub fn default_reel_directions(anchors: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
-    let centroid = anchors.iter().sum::<Vector3<f64>>() / anchors.len() as f64;
+    let centroid = centroid(anchors);
     anchors
         .iter()
         .map(|a| {
@@ -99,6 +99,11 @@ pub fn default_reel_directions(anchors: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
             }
         })
         .collect()
+}
+
+/// The anchors' centroid [m], the workspace's middle for the reel directions.
+fn centroid(anchors: &[Vector3<f64>]) -> Vector3<f64> {
+    anchors.iter().sum::<Vector3<f64>>() / anchors.len() as f64
 }
 
 impl LumpedSpatial {
@@ -120,12 +125,20 @@ impl LumpedSpatial {
             });
         }
         let m = robot.cables();
-        let centroid = robot.anchors().iter().sum::<Vector3<f64>>() / m as f64;
+        if reels.len() != m {
+            return Err(ModelError::Parameter {
+                name: "robot.reel_directions",
+                value: reels.len() as f64,
+                allowed: format!("one direction per anchor ({m})"),
+            });
+        }
+        let centroid = centroid(robot.anchors());
         let mut units = [Vector3::x(); MAX_CABLES];
-        for (i, r) in reels.iter().enumerate().take(m) {
+        for (i, r) in reels.iter().enumerate() {
             let norm = r.norm();
-            let outward = (robot.anchor(i) - centroid).dot(r);
-            let tolerance = -1e-9 * (robot.anchor(i) - centroid).norm();
+            let away = robot.anchor(i) - centroid;
+            let outward = away.dot(r);
+            let tolerance = -1e-9 * away.norm();
             if !(norm.is_finite() && norm > 0.0 && outward >= tolerance) {
                 return Err(ModelError::Parameter {
                     name: "robot.reel_directions",
@@ -142,13 +155,6 @@ impl LumpedSpatial {
                 });
             }
             units[i] = r / norm;
-        }
-        if reels.len() != m {
-            return Err(ModelError::Parameter {
-                name: "robot.reel_directions",
-                value: reels.len() as f64,
-                allowed: format!("one direction per anchor ({m})"),
-            });
         }
         let segment = cable.modelled_length / n as f64;
         Ok(Self {
@@ -350,12 +356,11 @@ impl CableModel<3> for LumpedSpatial {
         dv[cables..]
             .iter_mut()
             .for_each(|a| *a /= self.robot.effector_mass);
-        // A locked reel holds its reel end.
+        // A locked reel holds its reel end (its force is the lock's, [`Self::forces`]).
         if self.locked {
             for cable in 0..self.robot.cables() {
                 for axis in 0..3 {
-                    let i = self.index(cable, 0, axis);
-                    (dq[i], dv[i]) = (0.0, 0.0);
+                    dq[self.index(cable, 0, axis)] = 0.0;
                 }
             }
         }

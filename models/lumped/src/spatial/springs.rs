@@ -15,13 +15,10 @@ pub(super) struct SpringForces {
 impl LumpedSpatial {
     /// Length λ_j of spring j of `cable` along the cable path (eq. 4 over the pulley).
     pub fn spring_length(&self, y: &[f64], cable: usize, j: usize) -> f64 {
-        let (a, b) = (self.node(y, cable, j), self.node(y, cable, j + 1));
-        if j + 1 == self.stored[cable] {
-            let pulley = self.pulley(cable);
-            (pulley - a).norm() + (pulley - b).norm()
-        } else {
-            (b - a).norm()
-        }
+        crate::path::path_length(
+            (self.node(y, cable, j), self.node(y, cable, j + 1)),
+            (j + 1 == self.stored[cable]).then(|| self.pulley(cable)),
+        )
     }
 
     /// Length λ_j, rate λ̇_j and the unit vectors along which spring j pulls its end nodes (both
@@ -33,27 +30,14 @@ impl LumpedSpatial {
         cable: usize,
         j: usize,
     ) -> (f64, f64, Vector3<f64>, Vector3<f64>) {
-        let (a, b) = (self.node(y, cable, j), self.node(y, cable, j + 1));
-        let (va, vb) = (
-            self.node_velocity(y, cable, j),
-            self.node_velocity(y, cable, j + 1),
-        );
-        if j + 1 == self.stored[cable] {
-            let pulley = self.pulley(cable);
-            let (da, db) = (pulley - a, pulley - b);
-            let (la, lb) = (da.norm(), db.norm());
-            // A node exactly at the pulley: the limit of the path's direction is the chord's.
-            let toward = |d: Vector3<f64>, l: f64, other: Vector3<f64>| {
-                if l > 0.0 { d / l } else { other.normalize() }
-            };
-            let (ua, ub) = (toward(da, la, b - a), toward(db, lb, a - b));
-            (la + lb, -ua.dot(&va) - ub.dot(&vb), ua, ub)
-        } else {
-            let d = b - a;
-            let l = d.norm();
-            let u = d / l;
-            (l, u.dot(&(vb - va)), u, -u)
-        }
+        crate::path::spring_path(
+            (self.node(y, cable, j), self.node(y, cable, j + 1)),
+            (
+                self.node_velocity(y, cable, j),
+                self.node_velocity(y, cable, j + 1),
+            ),
+            (j + 1 == self.stored[cable]).then(|| self.pulley(cable)),
+        )
     }
 
     /// Tension of spring j of `cable` [N].
@@ -76,7 +60,8 @@ impl LumpedSpatial {
     }
 
     /// Net force on every position coordinate [N]: springs, gravity, the reel tensions on P_0;
-    /// a stored node keeps the component along its reel line (the guide reacts the rest).
+    /// a stored node keeps the component along its reel line (the guide reacts the rest), a
+    /// locked reel end none (the lock reacts it all).
     pub(super) fn forces(&mut self, y: &[f64], tensions: &[f64], out: &mut [f64]) {
         let n = self.elements;
         let weight = self.node_mass * self.gravity();
@@ -110,6 +95,11 @@ impl LumpedSpatial {
                 let along = reel * f.dot(&reel);
                 for axis in 0..3 {
                     out[self.index(cable, j, axis)] = along[axis];
+                }
+            }
+            if self.locked {
+                for axis in 0..3 {
+                    out[self.index(cable, 0, axis)] = 0.0;
                 }
             }
             self.scratch[cable] = s;

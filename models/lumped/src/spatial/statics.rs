@@ -35,9 +35,8 @@ pub struct Hang {
     pub free_length: f64,
 }
 
-/// The free part of one march: P_r … P_{N−1}, the end P_N and the last spring's force on it.
+/// One march: the end P_N, the last spring's force on it, and the straddling spring.
 struct March {
-    free: Vec<Vector3<f64>>,
     end: Vector3<f64>,
     pull: Vector3<f64>,
     straddle_tension: f64,
@@ -45,13 +44,15 @@ struct March {
 }
 
 /// Marches cable `cable` from its pulley for split `r`, angle `theta` [rad] in the plane of the
-/// horizontal unit `h` and z, and free share `phi` of the straddling spring.
+/// horizontal unit `h` and z, and free share `phi` of the straddling spring, handing each free
+/// node P_r … P_{N−1} to `node` (the shooting's own marches keep none).
 fn march(
     model: &LumpedSpatial,
     cable: usize,
     (r, theta, phi): (usize, f64, f64),
     tension: f64,
     h: Vector3<f64>,
+    mut node: impl FnMut(usize, Vector3<f64>),
 ) -> March {
     let (n, l0, k0) = (model.elements, model.segment, model.stiffness);
     let weight = model.node_mass * model.robot().gravity;
@@ -60,15 +61,13 @@ fn march(
     let e = h * theta.cos() + Vector3::z() * theta.sin();
     let mut p = model.pulley(cable) + e * (phi * straddle_length);
     let mut f = -e * straddle_tension;
-    let mut free = Vec::with_capacity(n - r);
-    for _ in r..n {
-        free.push(p);
+    for j in r..n {
+        node(j, p);
         f.z -= weight;
         let t = f.norm();
         p -= f * ((l0 + t / k0) / t);
     }
     March {
-        free,
         end: p,
         pull: f,
         straddle_tension,
@@ -97,7 +96,7 @@ fn shoot(
 ) -> Result<(f64, f64), ModelError> {
     let h = plane_of(model.pulley(cable), p);
     let miss = |theta: f64, phi: f64| {
-        let d = march(model, cable, (r, theta, phi), tension, h).end - p;
+        let d = march(model, cable, (r, theta, phi), tension, h, |_, _| {}).end - p;
         Vector2::new(d.dot(&h), d.z)
     };
     let (mut theta, mut phi) = start;
@@ -127,13 +126,35 @@ fn shoot(
     })
 }
 
-/// Cable `cable` at rest from its reel, pulled by `tension` [N], to the effector at `p` [m].
-pub fn hang(
+/// One cable's rest without its nodes: the split and the march that hangs it, and what it puts
+/// on the effector (the statics' Newton iterations need no more; [`hang`] adds the nodes).
+#[derive(Debug, Clone, Copy)]
+struct Settled {
+    stored: usize,
+    theta: f64,
+    phi: f64,
+    h: Vector3<f64>,
+    tension: f64,
+    /// The force the cable exerts on the effector [N].
+    pull: Vector3<f64>,
+}
+
+impl Settled {
+    /// Unstrained length from the pulley to the effector [m].
+    fn free_length(&self, model: &LumpedSpatial) -> f64 {
+        ((model.elements - self.stored) as f64 + self.phi) * model.segment
+    }
+}
+
+/// The split r, angle and share that hang cable `cable` from its reel under `tension` [N] to
+/// the effector at `p` [m]: shooting for a split guessed from the chord, moved by one node while
+/// the share falls outside (0, 1].
+fn settle(
     model: &LumpedSpatial,
     cable: usize,
     p: &Vector3<f64>,
     tension: f64,
-) -> Result<Hang, ModelError> {
+) -> Result<Settled, ModelError> {
     if tension <= 0.0 || tension.is_nan() {
         return Err(ModelError::State {
             t: 0.0,
@@ -152,18 +173,26 @@ pub fn hang(
         .saturating_sub((free / l0).ceil() as usize)
         .clamp(1, n);
     let mut guess = (chord.z.atan2(chord.dot(&h)), free / l0 - (n - r) as f64);
-    let mut visited = vec![false; n + 1];
+    // The split moves one way; a move back is a node that sits on the pulley.
+    let mut came_from = None;
     loop {
-        visited[r] = true;
         let (theta, phi) = shoot(model, cable, r, guess, tension, p)?;
         let next = if phi > 1.0 {
             (r > 1).then(|| (r - 1, phi - 1.0))
         } else if phi <= 0.0 {
             (r < n).then(|| (r + 1, phi + 1.0))
         } else {
-            return Ok(assemble(model, cable, (r, theta, phi), tension, h));
+            let m = march(model, cable, (r, theta, phi), tension, h, |_, _| {});
+            return Ok(Settled {
+                stored: r,
+                theta,
+                phi,
+                h,
+                tension,
+                pull: m.pull,
+            });
         };
-        let Some((next_r, next_phi)) = next.filter(|(k, _)| !visited[*k]) else {
+        let Some((next_r, next_phi)) = next.filter(|(k, _)| Some(*k) != came_from) else {
             return Err(ModelError::State {
                 t: 0.0,
                 why: format!(
@@ -175,37 +204,87 @@ pub fn hang(
                 ),
             });
         };
+        came_from = Some(r);
         (r, guess) = (next_r, (theta, next_phi));
     }
 }
 
-/// The whole chain of a converged march: stored nodes back along the reel line.
-fn assemble(
+/// Cable `cable` at rest from its reel, pulled by `tension` [N], to the effector at `p` [m].
+pub fn hang(
     model: &LumpedSpatial,
     cable: usize,
-    (r, theta, phi): (usize, f64, f64),
+    p: &Vector3<f64>,
     tension: f64,
-    h: Vector3<f64>,
-) -> Hang {
-    let m = march(model, cable, (r, theta, phi), tension, h);
+) -> Result<Hang, ModelError> {
+    Ok(assemble(model, cable, &settle(model, cable, p, tension)?))
+}
+
+/// The whole chain of a settled cable: its free nodes marched again, its stored nodes back
+/// along the reel line.
+fn assemble(model: &LumpedSpatial, cable: usize, s: &Settled) -> Hang {
     let (l0, k0) = (model.segment, model.stiffness);
-    let weight_along = model.node_mass * model.robot().gravity * model.reel(cable).z;
     let reel = model.reel(cable);
+    let weight_along = model.node_mass * model.robot().gravity * reel.z;
     let mut nodes = vec![Vector3::zeros(); model.elements];
-    let behind = ((1.0 - phi) * m.straddle_length).max(PULLEY_OFFSET);
+    let split = (s.stored, s.theta, s.phi);
+    let m = march(model, cable, split, s.tension, s.h, |j, p| nodes[j] = p);
+    let r = s.stored;
+    let behind = ((1.0 - s.phi) * m.straddle_length).max(PULLEY_OFFSET);
     nodes[r - 1] = model.pulley(cable) + reel * behind;
     for j in (0..r - 1).rev() {
-        let t = tension - (j + 1) as f64 * weight_along;
+        let t = s.tension - (j + 1) as f64 * weight_along;
         nodes[j] = nodes[j + 1] + reel * (l0 + t / k0);
     }
-    nodes[r..].copy_from_slice(&m.free);
     Hang {
         stored: r,
         nodes,
         pull: m.pull,
         straddle_tension: m.straddle_tension,
-        free_length: ((model.elements - r) as f64 + phi) * l0,
+        free_length: s.free_length(model),
     }
+}
+
+/// A root of [`newton_3`]: where, its residual, and the iterations it took.
+struct Root {
+    x: Vector3<f64>,
+    residual: Vector3<f64>,
+    iterations: usize,
+}
+
+/// Newton on a map x ∈ R³ → R³ from `x` by central differences of `step`, until |R(x)| ≤
+/// `tolerance`; where it stalls (30 iterations, or a singular Jacobian) the error `stalled`
+/// makes of the residual there.
+fn newton_3(
+    mut residual: impl FnMut(&Vector3<f64>) -> Result<Vector3<f64>, ModelError>,
+    mut x: Vector3<f64>,
+    (step, tolerance): (f64, f64),
+    stalled: impl FnOnce(Vector3<f64>) -> ModelError,
+) -> Result<Root, ModelError> {
+    let mut r = residual(&x)?;
+    for iterations in 0..=30 {
+        if r.norm() <= tolerance {
+            return Ok(Root {
+                x,
+                residual: r,
+                iterations,
+            });
+        }
+        if iterations == 30 {
+            break;
+        }
+        let mut jacobian = Matrix3::zeros();
+        for k in 0..3 {
+            let e = Vector3::ith(k, step);
+            let column = (residual(&(x + e))? - residual(&(x - e))?) / (2.0 * step);
+            jacobian.set_column(k, &column);
+        }
+        let Some(inv) = jacobian.try_inverse() else {
+            break;
+        };
+        x -= inv * r;
+        r = residual(&x)?;
+    }
+    Err(stalled(r))
 }
 
 /// The robot at rest at the rule's pose (every coordinate pinned), the tensions corrected by
@@ -227,57 +306,39 @@ pub(super) fn equilibrium(
     let base = rule.tensions(&[]);
     let m = model.robot().cables();
     let w = model.robot().structure_matrix(&p);
-    let columns = w.columns();
-    let gram: Matrix3<f64> = columns.iter().map(|u| u * u.transpose()).sum();
-    let gram_inv = gram.try_inverse().ok_or_else(|| ModelError::State {
+    let gram_inv = w.gram_inverse().ok_or_else(|| ModelError::State {
         t: 0.0,
         why: format!("the cables do not span space at {:?} m", p.as_slice()),
     })?;
     let tensions_for = |dw: &Vector3<f64>| {
         let lambda = gram_inv * dw;
-        PerCable::from_fn(m, |i| base[i] + columns[i].dot(&lambda))
+        PerCable::from_fn(m, |i| base[i] + w.column(i).dot(&lambda))
     };
     let lift = model.robot().effector_mass * model.robot().gravity;
     let residual = |dw: &Vector3<f64>| -> Result<Vector3<f64>, ModelError> {
         let t = tensions_for(dw);
         let mut sum = Vector3::new(0.0, 0.0, -lift);
         for i in 0..m {
-            sum += hang(model, i, &p, t[i])?.pull;
+            sum += settle(model, i, &p, t[i])?.pull;
         }
         Ok(sum)
     };
     let scale = lift + base.iter().map(|t| t.abs()).sum::<f64>();
-    let mut dw = Vector3::zeros();
-    let mut iterations = 0;
-    let mut r = residual(&dw)?;
-    while r.norm() > 1e-11 * scale {
-        if iterations == 30 {
-            return Err(ModelError::State {
-                t: 0.0,
-                why: format!(
-                    "the lumped cables' weight cannot be carried at {:?} m: the effector's \
-                     balance stalled at {:e} N",
-                    p.as_slice(),
-                    r.norm()
-                ),
-            });
-        }
-        let step = 1e-6 * scale;
-        let mut jacobian = Matrix3::zeros();
-        for k in 0..3 {
-            let e = Vector3::ith(k, step);
-            jacobian.set_column(
-                k,
-                &((residual(&(dw + e))? - residual(&(dw - e))?) / (2.0 * step)),
-            );
-        }
-        let Some(inv) = jacobian.try_inverse() else {
-            break;
-        };
-        dw -= inv * r;
-        r = residual(&dw)?;
-        iterations += 1;
-    }
+    let root = newton_3(
+        residual,
+        Vector3::zeros(),
+        (1e-6 * scale, 1e-11 * scale),
+        |r| ModelError::State {
+            t: 0.0,
+            why: format!(
+                "the lumped cables' weight cannot be carried at {:?} m: the effector's \
+                 balance stalled at {:e} N",
+                p.as_slice(),
+                r.norm()
+            ),
+        },
+    )?;
+    let (dw, r, iterations) = (root.x, root.residual, root.iterations);
     let tensions = tensions_for(&dw);
     let state = rest_state(model, &p, &tensions)?;
     Ok(Equilibrium {
@@ -289,7 +350,8 @@ pub(super) fn equilibrium(
     })
 }
 
-/// The state at rest with every cable hanging under `tensions`, and the model's split set.
+/// The state at rest with every cable hanging under `tensions` (velocities zero), and the
+/// model's split set.
 fn rest_state(
     model: &mut LumpedSpatial,
     p: &Vector3<f64>,
@@ -327,7 +389,21 @@ pub fn hang_with_length(
     p: &Vector3<f64>,
     free: f64,
 ) -> Result<Hang, ModelError> {
-    let excess = |t: f64| hang(model, cable, p, t).map(|h| (h.free_length - free, h));
+    Ok(assemble(
+        model,
+        cable,
+        &settle_with_length(model, cable, p, free)?,
+    ))
+}
+
+/// [`hang_with_length`] without the nodes.
+fn settle_with_length(
+    model: &LumpedSpatial,
+    cable: usize,
+    p: &Vector3<f64>,
+    free: f64,
+) -> Result<Settled, ModelError> {
+    let excess = |t: f64| settle(model, cable, p, t).map(|s| (s.free_length(model) - free, s));
     let ea = model.stiffness * model.segment;
     let chord = (p - model.pulley(cable)).norm();
     let weight = model.node_mass / model.segment * model.robot().gravity * free;
@@ -414,46 +490,31 @@ pub fn rest_with_lengths(
 ) -> Result<(Vector3<f64>, Vec<Hang>), ModelError> {
     let m = model.robot().cables();
     let lift = model.robot().effector_mass * model.robot().gravity;
-    let hangs = |p: &Vector3<f64>| -> Result<Vec<Hang>, ModelError> {
-        (0..m)
-            .map(|i| hang_with_length(model, i, p, lengths[i]))
-            .collect()
-    };
-    let residual = |hs: &[Hang]| {
-        hs.iter()
-            .fold(Vector3::new(0.0, 0.0, -lift), |f, h| f + h.pull)
-    };
-    let mut p = *guess;
-    let mut current = hangs(&p)?;
-    for _ in 0..50 {
-        let r = residual(&current);
-        let scale = lift + current.iter().map(|h| h.pull.norm()).sum::<f64>();
-        if r.norm() <= 1e-10 * scale {
-            return Ok((p, current));
+    let residual = |p: &Vector3<f64>| -> Result<Vector3<f64>, ModelError> {
+        let mut sum = Vector3::new(0.0, 0.0, -lift);
+        for (i, &free) in lengths.iter().enumerate().take(m) {
+            sum += settle_with_length(model, i, p, free)?.pull;
         }
-        let step = 1e-7;
-        let mut jacobian = Matrix3::zeros();
-        for k in 0..3 {
-            let e = Vector3::ith(k, step);
-            let plus = residual(&hangs(&(p + e))?);
-            let minus = residual(&hangs(&(p - e))?);
-            jacobian.set_column(k, &((plus - minus) / (2.0 * step)));
-        }
-        let delta = jacobian.try_inverse().ok_or_else(|| ModelError::State {
+        Ok(sum)
+    };
+    // Balanced to 1e-10 of the weight and the lines' pulls at the guess.
+    let pulls: f64 = (0..m)
+        .map(|i| settle_with_length(model, i, guess, lengths[i]).map(|s| s.pull.norm()))
+        .sum::<Result<f64, _>>()?;
+    let p = newton_3(residual, *guess, (1e-7, 1e-10 * (lift + pulls)), |r| {
+        ModelError::State {
             t: 0.0,
             why: format!(
-                "locked reels: the effector's stiffness is singular at {:?} m",
-                p.as_slice()
+                "locked reels at lengths {lengths:?} m: the effector's balance stalled at {:e} \
+                 N near {:?} m",
+                r.norm(),
+                guess.as_slice()
             ),
-        })? * r;
-        p -= delta;
-        current = hangs(&p)?;
-    }
-    Err(ModelError::State {
-        t: 0.0,
-        why: format!(
-            "locked reels at lengths {lengths:?} m: the effector's balance did not converge near {:?} m",
-            guess.as_slice()
-        ),
-    })
+        }
+    })?
+    .x;
+    let hangs = (0..m)
+        .map(|i| hang_with_length(model, i, &p, lengths[i]))
+        .collect::<Result<_, _>>()?;
+    Ok((p, hangs))
 }
