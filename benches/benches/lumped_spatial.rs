@@ -6,7 +6,7 @@
 
 use cdpr_bench::core::closed_loop::ClosedLoop;
 use cdpr_bench::core::runner::{RunOptions, simulate};
-use cdpr_bench::core::scenario::{IntegratorKind, Scenario};
+use cdpr_bench::core::scenario::{ControllerKind, IntegratorKind, Scenario};
 use cdpr_bench::lumped::spatial::LumpedSpatial;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -31,11 +31,20 @@ fn run(s: &Scenario, elements: usize) -> cdpr_bench::core::runner::Run {
 fn run_5s(c: &mut Criterion) {
     let mut group = c.benchmark_group("lumped_spatial/run_5s_integration_only");
     group.sample_size(10);
-    for (name, integrator) in [
-        ("hangprinter_n20_implicit", IntegratorKind::Implicit),
-        ("hangprinter_n20_dopri5", IntegratorKind::Dopri5),
+    for (name, integrator, length) in [
+        ("hangprinter_n20_implicit", IntegratorKind::Implicit, false),
+        ("hangprinter_n20_dopri5", IntegratorKind::Dopri5, false),
+        (
+            "hangprinter_n20_dopri5_length_reels",
+            IntegratorKind::Dopri5,
+            true,
+        ),
     ] {
-        let s = hangprinter(integrator, 5.0);
+        let mut s = hangprinter(integrator, 5.0);
+        if length {
+            // The firmware's reels: driven by length, flex compensation by the static load.
+            s.controller.kind = ControllerKind::Length;
+        }
         let r = run(&s, 20);
         eprintln!(
             "{name}: {} steps, {} RHS, {} Newton iterations, {} factorisations, {} events",

@@ -110,9 +110,10 @@ pub(crate) fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Er
     Ok((robot, config.kind))
 }
 
-/// What the spatial lumped cables run so far: three or more cables on tension reels.
+/// What the spatial lumped cables run: three or more cables, on reels pulled by tension, or
+/// driven by length on DOPRI5.
 fn check_lumped(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
-    use cdpr_core::scenario::ControllerKind;
+    use cdpr_core::scenario::{ControllerKind, IntegratorKind};
     let refuse = |key: &'static str, value: String, allowed: &str| -> Result<(), Error> {
         Err(out_of_range(key, value, allowed.to_owned()).into())
     };
@@ -123,11 +124,14 @@ fn check_lumped(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
             "3 to 8 anchors for the spatial lumped cables (two cables in space run elastic)",
         );
     }
-    if scenario.controller.kind == ControllerKind::Length {
+    if scenario.controller.kind == ControllerKind::Length
+        && scenario.simulation.integrator == IntegratorKind::Implicit
+    {
         return refuse(
-            "controller.kind",
-            "\"length\" with model.kind = \"lumped\"".into(),
-            "a tension controller: reels driven by length on massive cables are not built yet",
+            "simulation.integrator",
+            "\"implicit\" with controller.kind = \"length\" and model.kind = \"lumped\"".into(),
+            "\"dopri5\": reels driven by length on massive cables run on DOPRI5 (the reel's \
+             velocity loop is not in the second-order form)",
         );
     }
     Ok(())

@@ -9,7 +9,7 @@ use cdpr_bench::ModelKind;
 use cdpr_bench::analysis::spatial::SpatialMetrics;
 use cdpr_bench::core::robot::distribution::DistributionMethod;
 use cdpr_bench::core::runner::Observer;
-use cdpr_bench::core::scenario::{ControllerKind, FlexCompensation, Scenario};
+use cdpr_bench::core::scenario::{ControllerKind, FlexCompensation, IntegratorKind, Scenario};
 
 /// One run of the table.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -56,18 +56,17 @@ fn flex_name(flex: FlexCompensation) -> &'static str {
 /// table's order, whatever the machine).
 pub fn table(scenario: &Scenario) -> Result<Vec<MoveRow>> {
     let mut jobs = Vec::new();
-    // Lumped lines run the tension controllers only (length reels on massive cables are not
-    // built yet).
     let massive = cdpr_bench::ModelConfig::from_scenario(scenario)?.kind != ModelKind::Elastic;
     for (name, kind, flex) in controllers() {
-        if massive && kind == ControllerKind::Length {
-            continue;
-        }
         for method in DistributionMethod::ALL {
             let mut s = scenario.clone();
             s.controller.kind = kind;
             s.controller.flex_compensation = flex;
             s.controller.distribution = method;
+            if massive && kind == ControllerKind::Length {
+                // Reels driven by length on massive lines run on DOPRI5 only.
+                s.simulation.integrator = IntegratorKind::Dopri5;
+            }
             s.validate()?;
             jobs.push((name.clone(), method, s));
         }

@@ -345,6 +345,26 @@ pub trait CableModel<const D: usize> {
         self.reel_speeds(state)
     }
 
+    /// Whether the model's reels can follow commanded unstrained lengths by moving its reel
+    /// ends ([`CableModel::drive_reels`]): massive cables can. Massless cables cannot: their
+    /// `length` controller acts through eq. 1's tensions.
+    fn reels_follow_lengths(&self) -> bool {
+        false
+    }
+
+    /// From the next right-hand side on, drives every reel so that its free unstrained length
+    /// changes at `rates` l̇0_i [m/s] and `accelerations` l̈0_i [m/s²] (positive: paying out);
+    /// the commanded tensions are then not applied. Only called when
+    /// [`CableModel::reels_follow_lengths`].
+    fn drive_reels(&mut self, _rates: &PerCable, _accelerations: &PerCable) {}
+
+    /// The reels' power into the cables at `state` [W], for the commanded `tensions` and the
+    /// `reel_speeds` of the same state: Σ T_i v_reel,i, unless the reels are driven by length
+    /// (then the model's reel-end forces do the work).
+    fn reel_power(&self, _state: &[f64], tensions: &Tensions, reel_speeds: &PerCable) -> f64 {
+        tensions.dot(reel_speeds)
+    }
+
     /// Energy terms of `state`.
     fn energy(&self, state: &[f64]) -> Energy;
 
@@ -454,6 +474,15 @@ impl<const D: usize, M: CableModel<D> + ?Sized> CableModel<D> for Box<M> {
         rate: &mut [f64],
     ) -> PerCable {
         (**self).rhs_and_reel_speeds(t, state, tensions, rate)
+    }
+    fn reels_follow_lengths(&self) -> bool {
+        (**self).reels_follow_lengths()
+    }
+    fn drive_reels(&mut self, rates: &PerCable, accelerations: &PerCable) {
+        (**self).drive_reels(rates, accelerations)
+    }
+    fn reel_power(&self, state: &[f64], tensions: &Tensions, reel_speeds: &PerCable) -> f64 {
+        (**self).reel_power(state, tensions, reel_speeds)
     }
     fn energy(&self, state: &[f64]) -> Energy {
         (**self).energy(state)

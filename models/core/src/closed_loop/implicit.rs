@@ -146,7 +146,7 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         s.effector = effector;
         s.states[..c].copy_from_slice(&y[n..n + c]);
         s.saturated = cmd.saturated;
-        s.power = cmd.tensions.dot(&reel);
+        s.power = self.model.reel_power(model_state, &cmd.tensions, &reel);
         s.dissipation = dissipation;
         s.work = y[n + c];
         s.dissipated = y[n + c + 1];
@@ -240,7 +240,7 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         let cmd = self.step_end_command(t, &effector, &mut states);
         y[n..n + c].copy_from_slice(&states[..c]);
         let reel = self.model.reel_speeds(&y[..n]);
-        let power = cmd.tensions.dot(&reel);
+        let power = self.model.reel_power(&y[..n], &cmd.tensions, &reel);
         let dissipation = self.model.dissipation(&y[..n]);
         let s = &self.step_start;
         y[n + c] = s.work + 0.5 * s.h * (s.power + power);

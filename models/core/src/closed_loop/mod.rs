@@ -4,7 +4,8 @@
 //!
 //! State layout: `[model state (n) | controller states (c) | W | D]`: the controller's own states
 //! (the paper's PID: integral w and filter f), then two audit states excluded from the error
-//! norm, the reels' work W = ∫ Σ T_i v_reel,i dt and the energy dissipated inside the model D.
+//! norm, the reels' work W = ∫ Σ T_i v_reel,i dt (or the work of a model's reels driven by
+//! length, [`CableModel::reel_power`]) and the energy dissipated inside the model D.
 //! They make the energy balance E(t) − E(0) − W(t) + D(t) − ΣΔE = 0 (ΔE the energy changes of
 //! model events) a channel of every run.
 
@@ -82,7 +83,17 @@ pub struct ClosedLoop<M: CableModel<D>, const D: usize> {
     step_start: implicit::StepStart<D>,
     /// Two residuals for the tension columns of the implicit iteration matrix (allocated once).
     residual_scratch: [Vec<f64>; 2],
+    /// Whether the reels follow the controller's unstrained lengths in the model itself (the
+    /// `length` controller on massive cables): see [`ClosedLoop::drives_reels_by_length`].
+    length_drive: bool,
 }
+
+/// Central-difference half-step in time [s] for the commanded lengths' rate and acceleration:
+/// the rate's truncation h² l0‴/6 stays below 2e-7 m/s for length jerks ≲ 1e2 m/s³ (3e-8 m
+/// over a 0.2 s move), the acceleration's round-off 1e-16 m / h² = 1e-8 m/s², and the reel's
+/// velocity loop corrects what remains. Three evaluations of the lengths per right-hand side
+/// (each a distribution at the reference) are the drive's cost.
+const LENGTH_DIFFERENCE_STEP: f64 = 1e-4;
 
 impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
     /// The loop for `model` with the scenario's controller, limits and trajectory; refused when
@@ -99,6 +110,8 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         let feedforward = controller.uses_reference_derivatives();
         let m = model.cables();
         let path = spatial::path(scenario, m);
+        let length_drive =
+            scenario.controller.kind == ControllerKind::Length && model.reels_follow_lengths();
         Ok(Self {
             model,
             trajectory: Step5::from(&scenario.trajectory),
@@ -121,7 +134,30 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
             rest_tensions: Tensions::zeros(m),
             step_start: implicit::StepStart::default(),
             residual_scratch: Default::default(),
+            length_drive,
         })
+    }
+
+    /// Whether the reels are driven by length inside the model (the `length` controller on a
+    /// model whose reels follow lengths, [`CableModel::reels_follow_lengths`]): the commanded
+    /// tensions are then the elastic law's estimate, reported but not applied.
+    pub fn drives_reels_by_length(&self) -> bool {
+        self.length_drive && matches!(self.actuation, Actuation::Controller)
+    }
+
+    /// Hands the model the commanded lengths' rate l̇0_i and acceleration l̈0_i at t [s], by
+    /// central differences of [`ClosedLoop::commanded_lengths`] (the flex compensation's
+    /// distribution makes them awkward in closed form) with the half-step
+    /// [`LENGTH_DIFFERENCE_STEP`].
+    fn drive_reels(&mut self, t: f64) {
+        let at = |t: f64| self.commanded_lengths(t).unwrap_or_default();
+        let h = LENGTH_DIFFERENCE_STEP;
+        let (ahead, now, behind) = (at(t + h), at(t), at(t - h));
+        let m = self.model.cables();
+        let rates = PerCable::from_fn(m, |i| (ahead[i] - behind[i]) / (2.0 * h));
+        let accelerations =
+            PerCable::from_fn(m, |i| (ahead[i] - 2.0 * now[i] + behind[i]) / (h * h));
+        self.model.drive_reels(&rates, &accelerations);
     }
 
     /// The robot.
@@ -265,7 +301,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         let (rates, audits) = out.split_at_mut(c);
         self.controller
             .state_rate(reference, effector, &y[n..n + c], cmd.saturated, rates);
-        audits[0] = cmd.tensions.dot(reel);
+        audits[0] = self.model.reel_power(model_state, &cmd.tensions, reel);
         audits[1] = self.model.dissipation(model_state);
     }
 }
@@ -281,6 +317,9 @@ impl<M: CableModel<D>, const D: usize> OdeSystem for ClosedLoop<M, D> {
         let reference = self.reference(t);
         let states = &y[n..n + self.controller_len()];
         let cmd = self.command_with(t, &reference, &effector, states);
+        if self.drives_reels_by_length() {
+            self.drive_reels(t);
+        }
         let (model_rate, tail) = dy.split_at_mut(n);
         let reel = self
             .model

@@ -337,6 +337,13 @@ fn unsupported<M: CableModel<D>, const D: usize>(
             model: sys.model.name(),
             why: "the model offers no second-order form",
         })
+    } else if opts.integrator == IntegratorKind::Implicit && sys.drives_reels_by_length() {
+        Some(RunError::Unsupported {
+            integrator: IntegratorKind::Implicit.name(),
+            model: sys.model.name(),
+            why: "reels driven by length on massive cables run on DOPRI5 (the reel's velocity \
+                  loop is not in the second-order form)",
+        })
     } else {
         None
     }

@@ -64,10 +64,10 @@ impl LumpedSpatial {
         }
     }
 
-    /// The projection of node `j`'s force rows: r_i r_iᵀ for a stored node, 0 for a locked reel
-    /// end, I for a free node.
+    /// The projection of node `j`'s force rows: r_i r_iᵀ for a stored node, 0 for one on a
+    /// locked reel, I for a free node.
     fn row_projection(&self, cable: usize, j: usize) -> Matrix3<f64> {
-        if j == 0 && self.locked {
+        if j < self.stored[cable] && self.drive != super::reel::ReelDrive::Tension {
             Matrix3::zeros()
         } else if j < self.stored[cable] {
             let r = self.reels[cable];

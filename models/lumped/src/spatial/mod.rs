@@ -19,13 +19,14 @@
 //! sweep vectorises), then the effector's (x, y, z): 3mN + 3 positions, then the velocities in
 //! the same order. The stored-node counts r_i are the model's discrete mode.
 //!
-//! [`springs`]: the springs and the forces; [`pulley`]: the passages; [`statics`]: the rest
-//! (and with locked reels); [`implicit`]: the second-order form; [`modal`]: the coordinates for
-//! a modal analysis.
+//! [`springs`]: the springs and the forces; [`reel`]: the reels, pulled by tension, locked or
+//! driven by length; [`pulley`]: the passages; [`statics`]: the rest (and with locked reels);
+//! [`implicit`]: the second-order form; [`modal`]: the coordinates for a modal analysis.
 
 mod implicit;
 mod modal;
 mod pulley;
+mod reel;
 mod springs;
 mod statics;
 
@@ -36,6 +37,7 @@ use cdpr_core::robot::{Effector, MAX_CABLES, PerCable, Robot};
 use cdpr_core::scenario::Scenario;
 use nalgebra::Vector3;
 
+pub use reel::REEL_TIME_CONSTANT;
 pub use statics::{Hang, hang, hang_with_length, rest_with_lengths};
 
 /// The scenario's cable as the spatial lumped model needs it.
@@ -71,9 +73,8 @@ pub struct LumpedSpatial {
     reels: [Vector3<f64>; MAX_CABLES],
     /// Stored nodes r_i of each cable (nodes 0 … r_i − 1 lie on the reel line).
     stored: [usize; MAX_CABLES],
-    /// Reels locked: every reel end P_0 held where it is (the commanded tensions then act on
-    /// nothing that moves).
-    locked: bool,
+    /// What moves the reel ends P_0: the commanded tensions, a lock, or the length drive.
+    drive: reel::ReelDrive,
     /// Per cable, the forces of its springs on their two end nodes (allocated once).
     scratch: Vec<springs::SpringForces>,
     /// Buffers of the second-order form ([`implicit`]).
@@ -166,7 +167,7 @@ impl LumpedSpatial {
             damping: cable.axial_damping / segment,
             reels: units,
             stored: [n / 2; MAX_CABLES],
-            locked: false,
+            drive: reel::ReelDrive::Tension,
             implicit: Default::default(),
             scratch: vec![
                 springs::SpringForces {
@@ -262,10 +263,15 @@ impl LumpedSpatial {
         Ok(())
     }
 
-    /// Locks (or frees) every reel: a locked reel holds its reel end P_0 still, the length
-    /// reels holding still; the robot is then a conservative system (no reel work).
+    /// Locks every reel (or hands it back to the commanded tensions): a locked reel holds its
+    /// reel end P_0 still, the length reels holding still; the robot is then a conservative
+    /// system (no reel work).
     pub fn lock_reels(&mut self, locked: bool) {
-        self.locked = locked;
+        self.drive = if locked {
+            reel::ReelDrive::Locked
+        } else {
+            reel::ReelDrive::Tension
+        };
     }
 
     /// Stored nodes per cable, r_i.
@@ -356,14 +362,6 @@ impl CableModel<3> for LumpedSpatial {
         dv[cables..]
             .iter_mut()
             .for_each(|a| *a /= self.robot.effector_mass);
-        // A locked reel holds its reel end (its force is the lock's, [`Self::forces`]).
-        if self.locked {
-            for cable in 0..self.robot.cables() {
-                for axis in 0..3 {
-                    dq[self.index(cable, 0, axis)] = 0.0;
-                }
-            }
-        }
         // Stored nodes move along their reel line only.
         for cable in 0..self.robot.cables() {
             let reel = self.reels[cable];
@@ -389,6 +387,29 @@ impl CableModel<3> for LumpedSpatial {
         PerCable::from_fn(self.robot.cables(), |c| {
             self.node_velocity(y, c, 0).dot(&self.reels[c])
         })
+    }
+
+    fn reels_follow_lengths(&self) -> bool {
+        true
+    }
+
+    fn drive_reels(&mut self, rates: &PerCable, accelerations: &PerCable) {
+        let mut drive = ([0.0; MAX_CABLES], [0.0; MAX_CABLES]);
+        let m = self.robot.cables();
+        drive.0[..m].copy_from_slice(&rates[..m]);
+        drive.1[..m].copy_from_slice(&accelerations[..m]);
+        self.drive = reel::ReelDrive::Length {
+            rates: drive.0,
+            accelerations: drive.1,
+        };
+    }
+
+    /// Σ T_i v_reel,i under tension; the reel-end forces' power when locked or driven.
+    fn reel_power(&self, y: &[f64], tensions: &PerCable, reel_speeds: &PerCable) -> f64 {
+        match self.drive {
+            reel::ReelDrive::Tension => tensions.dot(reel_speeds),
+            _ => self.driven_reel_power(y),
+        }
     }
 
     fn energy(&self, y: &[f64]) -> Energy {

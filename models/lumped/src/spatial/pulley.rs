@@ -7,7 +7,8 @@
 //!   becomes free at A − ε r_i, velocity kept (it lies along r_i); r ← r − 1;
 //! - the first free node P_r reaches the pulley ((P_r − A)·r_i rises through 0): it becomes
 //!   stored at A + ε r_i, its velocity reduced to the component along r_i (the guide takes the
-//!   rest: the recorded energy change); r ← r + 1.
+//!   rest: the recorded energy change), or on a locked or driven reel set to the reel's speed;
+//!   r ← r + 1.
 //!
 //! A third function per cable watches every other node; one passing the pulley out of order
 //! stops the run as a modelling error.
@@ -102,6 +103,19 @@ pub(super) fn apply_event(
         _ => return Err(crate::pulley::out_of_order(t, cable, r)),
     };
     model.set_stored(&stored);
+    if kind == 1
+        && let Some((speed, _)) = model.reel_command(y, cable)
+    {
+        // A locked or driven reel takes the node at its own speed.
+        place(
+            model,
+            y,
+            cable,
+            j,
+            pulley + reel * PULLEY_OFFSET,
+            reel * speed,
+        );
+    }
     Ok(ModelEvent {
         t,
         cable: cable + 1,

@@ -60,8 +60,8 @@ impl LumpedSpatial {
     }
 
     /// Net force on every position coordinate [N]: springs, gravity, the reel tensions on P_0;
-    /// a stored node keeps the component along its reel line (the guide reacts the rest), a
-    /// locked reel end none (the lock reacts it all).
+    /// a stored node keeps the component along its reel line (the guide reacts the rest), or on
+    /// a locked or driven reel m times the acceleration the reel gives it ([`super::reel`]).
     pub(super) fn forces(&mut self, y: &[f64], tensions: &[f64], out: &mut [f64]) {
         let n = self.elements;
         let weight = self.node_mass * self.gravity();
@@ -79,10 +79,14 @@ impl LumpedSpatial {
                 }
             }
             let reel = self.reels[cable];
+            let pull = match self.drive {
+                super::reel::ReelDrive::Tension => tensions[cable],
+                _ => 0.0,
+            };
             for axis in 0..3 {
                 let f = &mut out[self.index(cable, 0, axis)..][..n];
                 let (a, b) = (&s.a[axis], &s.b[axis]);
-                f[0] = a[0] + tensions[cable] * reel[axis];
+                f[0] = a[0] + pull * reel[axis];
                 for ((f, a), b) in f[1..].iter_mut().zip(&a[1..]).zip(&b[..n - 1]) {
                     *f = a + b;
                 }
@@ -97,9 +101,12 @@ impl LumpedSpatial {
                     out[self.index(cable, j, axis)] = along[axis];
                 }
             }
-            if self.locked {
-                for axis in 0..3 {
-                    out[self.index(cable, 0, axis)] = 0.0;
+            if let Some(command) = self.reel_command(y, cable) {
+                for j in 0..r {
+                    let a = self.stored_acceleration(y, cable, j, command);
+                    for axis in 0..3 {
+                        out[self.index(cable, j, axis)] = self.node_mass * a * reel[axis];
+                    }
                 }
             }
             self.scratch[cable] = s;
