@@ -10,8 +10,10 @@ The case (MoorDyn's frame: z up; in air: rho = 0, no drag, no added mass, no ben
   initial:  {"points": [[x, y, z, vx, vy, vz] per point],
              "lines": [[[x, y, z, vx, vy, vz] per interior node] per line]}
             loaded through MoorDyn's state file (its own catenary start is not used)
-  gravity:  m/s^2; dt: MoorDyn's RK4 step dtM [s]; t_end, sample [s]; watch: a point's index
-The answer: "samples" (times), "watch" (the watched point's [x, y, z] per sample), "dt".
+  gravity:  m/s^2; dt: MoorDyn's RK4 step dtM [s]; t_end, sample [s]; watch: a point's index;
+  watch_node (optional): [line, node], a line's node (0 = its end a) to watch as well
+The answer: "samples" (times), "watch" (the watched point's [x, y, z] per sample), "dt", and
+with watch_node "node" (that node's [x, y, z] per sample).
 """
 
 import json
@@ -107,6 +109,10 @@ def run(case):
         load_initial(system, tmp, case["initial"])
         watched = moordyn.GetPoint(system, int(case["watch"]) + 1)
         answer = {"samples": [], "watch": [], "dt": float(case["dt"])}
+        node = case.get("watch_node")
+        if node is not None:
+            line = moordyn.GetLine(system, int(node[0]) + 1)
+            answer["node"] = []
         t, sample = 0.0, float(case["sample"])
         steps = int(round(float(case["t_end"]) / sample))
         for k in range(1, steps + 1):
@@ -114,6 +120,8 @@ def run(case):
             t = k * sample
             answer["samples"].append(t)
             answer["watch"].append(list(moordyn.GetPointPos(watched)))
+            if node is not None:
+                answer["node"].append(list(moordyn.GetLineNodePos(line, int(node[1]))))
     return answer
 
 
