@@ -15,6 +15,7 @@ pub mod damping;
 pub mod linearise;
 pub mod metrics;
 pub mod modes;
+pub mod rest_modes;
 pub mod spatial;
 pub mod spectrum;
 
@@ -36,6 +37,9 @@ pub enum AnalysisError {
     Modal(#[from] ModalError),
     #[error("no oscillatory closed-loop mode found")]
     NoMode,
+    /// The model offers no second-order form to read its mass and stiffness from.
+    #[error("the model offers no second-order form (mass and stiffness matrices)")]
+    NoSecondOrder,
     /// The dense eigen-analysis would cost more than it is allowed (time O(n³), memory O(n²)).
     #[error(
         "the linearised loop has {states} states, more than the dense eigen-analysis's limit of {limit} (lumped N ≤ 249, FE N ≤ 499)"

@@ -1,7 +1,10 @@
 //! Every mode of a model at one effector position, classified from its eigenvector as effector
 //! vertical, effector horizontal / controller, transverse string mode of cable 1 or 2, or axial
-//! mode of cable 1 or 2, by the share of the mass-weighted displacement each holds. The model says
-//! what its coordinates are ([`cdpr_core::modal_layout::ModalLayout`]); this module knows no model.
+//! mode of cable 1 or 2, by the share of the mass-weighted displacement each holds. In space the
+//! effector's horizontal share splits into x and y, and a cable's transverse share into the
+//! string's motion in its vertical plane (through its pulley and the effector) and across it
+//! (MODELS.md §11). The model says what its coordinates are
+//! ([`cdpr_core::modal_layout::ModalLayout`]); this module knows no model.
 
 use cdpr_core::modal_layout::{Dof, ModalLayout};
 use cdpr_core::robot::Tensions;
@@ -18,6 +21,14 @@ pub enum ModeKind {
     Transverse(usize),
     /// Axial (stretch) mode of cable 1 or 2.
     Axial(usize),
+    /// In space: the effector moving along x (the loop's x poles in closed loop).
+    EffectorX,
+    /// In space: the effector moving along y.
+    EffectorY,
+    /// In space: string mode of cable k in its vertical plane.
+    InPlane(usize),
+    /// In space: string mode of cable k across its vertical plane.
+    OutOfPlane(usize),
 }
 
 impl std::fmt::Display for ModeKind {
@@ -27,6 +38,10 @@ impl std::fmt::Display for ModeKind {
             ModeKind::Horizontal => write!(f, "effector horizontal / controller"),
             ModeKind::Transverse(c) => write!(f, "transverse cable {}", c + 1),
             ModeKind::Axial(c) => write!(f, "axial cable {}", c + 1),
+            ModeKind::EffectorX => write!(f, "effector x"),
+            ModeKind::EffectorY => write!(f, "effector y"),
+            ModeKind::InPlane(c) => write!(f, "in-plane string cable {}", c + 1),
+            ModeKind::OutOfPlane(c) => write!(f, "out-of-plane string cable {}", c + 1),
         }
     }
 }
@@ -91,7 +106,10 @@ impl Analysis {
 
 /// The kind holding the largest share of Σ m |u|² over the position part `u` of an eigenvector,
 /// and that share. Effector: x → horizontal, z → vertical; a free node: its component along the
-/// cable tangent → axial, across → transverse; an axial coordinate → axial.
+/// cable tangent → axial, across → transverse; an axial coordinate → axial. In space: the
+/// effector's x and y apart, and a free node's transverse part split along n = t × ẑ/|t × ẑ|
+/// (out of the vertical plane its tangent t lies in) and the rest (in-plane); a node on a
+/// vertical tangent, whose plane is any, counts as in-plane.
 pub fn classify(layout: &ModalLayout, u: &[(f64, f64)]) -> (ModeKind, f64) {
     let abs2 = |(re, im): (f64, f64)| re * re + im * im;
     let cables = layout
@@ -103,15 +121,20 @@ pub fn classify(layout: &ModalLayout, u: &[(f64, f64)]) -> (ModeKind, f64) {
         })
         .max()
         .unwrap_or(0);
-    // [vertical, horizontal, transverse per cable…, axial per cable…]
-    let mut share = vec![0.0f64; 2 + 2 * cables];
-    let (transverse, axial) = (2, 2 + cables);
+    // [vertical, horizontal (x), transverse (in-plane) per cable…, axial per cable…, then in
+    // space: y, out-of-plane per cable…]: the plane's shares first, in the plane's order.
+    let mut share = vec![0.0f64; 3 + 3 * cables];
+    let (transverse, axial, y, out) = (2, 2 + cables, 2 + 2 * cables, 3 + 2 * cables);
+    let spatial = layout.dofs.iter().any(|dof| match dof {
+        Dof::Effector { coordinates, .. } => coordinates.len() == 3,
+        _ => false,
+    });
     for dof in &layout.dofs {
         match dof {
             Dof::Effector { coordinates, mass } => {
                 let (vertical, horizontal) = coordinates.split_last().expect("one axis at least");
-                for &k in horizontal {
-                    share[1] += mass * abs2(u[k]);
+                for (axis, &k) in horizontal.iter().enumerate() {
+                    share[if axis == 1 { y } else { 1 }] += mass * abs2(u[k]);
                 }
                 share[0] += mass * abs2(u[*vertical]);
             }
@@ -122,8 +145,10 @@ pub fn classify(layout: &ModalLayout, u: &[(f64, f64)]) -> (ModeKind, f64) {
                 mass,
             } => {
                 let (along, across) = split_along(coordinates, tangent, u);
+                let across_plane = out_of_plane(coordinates, tangent, u).min(across);
                 share[axial + cable] += mass * along;
-                share[transverse + cable] += mass * across;
+                share[transverse + cable] += mass * (across - across_plane);
+                share[out + cable] += mass * across_plane;
             }
             Dof::Axial { cable, index, mass } => share[axial + cable] += mass * abs2(u[*index]),
         }
@@ -136,9 +161,13 @@ pub fn classify(layout: &ModalLayout, u: &[(f64, f64)]) -> (ModeKind, f64) {
         .expect("two shares at least");
     let kind = match best {
         0 => ModeKind::Vertical,
+        1 if spatial => ModeKind::EffectorX,
         1 => ModeKind::Horizontal,
+        k if k < axial && spatial => ModeKind::InPlane(k - transverse),
         k if k < axial => ModeKind::Transverse(k - transverse),
-        k => ModeKind::Axial(k - axial),
+        k if k < y => ModeKind::Axial(k - axial),
+        k if k == y => ModeKind::EffectorY,
+        k => ModeKind::OutOfPlane(k - out),
     };
     // No displacement at all (a pure controller-state mode): the controller's x loop.
     if total == 0.0 {
@@ -168,6 +197,23 @@ fn split_along(coordinates: &[usize], tangent: &[f64], u: &[(f64, f64)]) -> (f64
     let along = dot(tangent);
     let total: f64 = coordinates.iter().map(|&k| abs2(u[k])).sum();
     (abs2(along), (total - abs2(along)).max(0.0))
+}
+
+/// |u·n|² of a node's complex displacement `u` across the vertical plane of its unit `tangent`
+/// t (n = t × ẑ normalised; 0 in the plane, or on a vertical tangent).
+fn out_of_plane(coordinates: &[usize], tangent: &[f64], u: &[(f64, f64)]) -> f64 {
+    let [tx, ty, _] = *tangent else {
+        return 0.0;
+    };
+    // t × ẑ = (t_y, −t_x, 0).
+    let norm = tx.hypot(ty);
+    if norm < 1e-9 {
+        return 0.0;
+    }
+    let n = [ty / norm, -tx / norm];
+    let (x, y) = (u[coordinates[0]], u[coordinates[1]]);
+    let (re, im) = (n[0] * x.0 + n[1] * y.0, n[0] * x.1 + n[1] * y.1);
+    re * re + im * im
 }
 
 /// Taut-string transverse frequency ω_k = (kπ/l)√(T/μ_s) [rad/s] of a span of chord `length` l

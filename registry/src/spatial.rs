@@ -63,26 +63,16 @@ pub fn prepare_spatial(scenario: &Scenario) -> Result<Robot<3>, Error> {
     Ok(robot)
 }
 
-/// The scenario's spatial robot with its model checked, for the studies that run the massless
-/// elastic cables (a massive model is refused by name) — what a statics or modes study needs,
-/// without the move.
+/// The scenario's spatial robot with its model checked — what the modes study needs, without the
+/// move (it runs the massless elastic cables, and the lumped lines' locked modes when the
+/// scenario has them).
 pub fn spatial_robot(scenario: &Scenario) -> Result<Robot<3>, Error> {
-    let (robot, kind) = run_robot(scenario)?;
-    if kind != ModelKind::Elastic {
-        return Err(out_of_range(
-            "model.kind",
-            format!("\"{kind}\" with robot.anchors"),
-            "\"elastic\" for this study (the lumped cables in space run `simulate` moves and \
-             prints so far)",
-        )
-        .into());
-    }
-    Ok(robot)
+    Ok(run_robot(scenario)?.0)
 }
 
 /// The scenario's spatial robot and the cable model its move runs, checked: the massless elastic
-/// cables, or the lumped ones (MODELS.md §4 in space) under a tension controller — the length
-/// reels on lumped cables are refused by name.
+/// cables, or the lumped ones (MODELS.md §4 in space) — reels driven by length on the lumped
+/// cables on DOPRI5 only, refused by name on the implicit path.
 pub(crate) fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Error> {
     let robot = scenario.spatial_robot().ok_or_else(|| {
         out_of_range(

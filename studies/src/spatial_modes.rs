@@ -2,8 +2,10 @@
 //! its direction: the effector on its cables with the reels holding their tensions (the
 //! geometric stiffness Σ (T_i/l_i)(I − u_i u_iᵀ), MODELS.md §11), with the reels locked
 //! (K = Σ (EA/l_i) u_i u_iᵀ + (T_i/l_i) I), and in the scenario's closed loop (the elastic
-//! model and its controller, linearised by central differences at rest at the pose). The
-//! tensions at rest are the scenario's distribution of the weight there.
+//! model and its controller, linearised by central differences at rest at the pose); for a
+//! scenario on lumped lines also every mode of the lines and the effector with the reels locked,
+//! each named (effector x, y, vertical; each cable's string in and across its vertical plane;
+//! axial). The tensions at rest are the scenario's distribution of the weight there.
 
 use crate::{Result, StudyError};
 use cdpr_bench::analysis::linearise::closed_loop_jacobian;
@@ -24,6 +26,9 @@ pub enum SpatialLoop {
     LockedReels,
     /// The scenario's controller closing the loop.
     Closed,
+    /// The scenario's lumped lines at rest, reels locked (the firmware's robot between moves):
+    /// every mode of the lines and the effector, named.
+    LumpedLockedReels,
 }
 
 /// One mode.
@@ -78,6 +83,11 @@ pub fn at_pose(scenario: &Scenario, pose: [f64; 3]) -> Result<SpatialModes> {
     };
     let mut modes = open_loop_modes(&robot, &p, &tensions, ea);
     modes.extend(closed_loop_modes(&mut sys, &y, &robot, pose)?);
+    let config = cdpr_bench::ModelConfig::from_scenario(scenario)?;
+    if config.kind == cdpr_bench::ModelKind::Lumped && robot.cables() > 2 {
+        let elements = config.lumped().map_err(cdpr_bench::Error::from)?.elements;
+        modes.extend(lumped_locked_modes(scenario, elements, &p, &tensions)?);
+    }
     Ok(SpatialModes {
         pose,
         tensions: tensions.to_vec(),
@@ -123,6 +133,48 @@ fn open_loop_modes(robot: &Robot<3>, p: &Vector<3>, tensions: &[f64], ea: f64) -
         }
     }
     modes
+}
+
+/// Every mode of the scenario's lumped lines of `elements` springs at rest at `p` [m] under
+/// `tensions` [N], reels then locked, each named (`cdpr_analysis::rest_modes`).
+fn lumped_locked_modes(
+    scenario: &Scenario,
+    elements: usize,
+    p: &Vector<3>,
+    tensions: &[f64],
+) -> Result<Vec<SpatialMode>> {
+    use cdpr_bench::core::model::{CableModel, PoseRule};
+    let fail = |e: String| StudyError::Failed(format!("lumped modes at {:?} m: {e}", p.as_slice()));
+    let mut model = cdpr_bench::lumped::spatial::LumpedSpatial::from_scenario(scenario, elements)
+        .map_err(|e| fail(e.to_string()))?;
+    let hold = cdpr_bench::core::robot::Tensions::from_slice(tensions);
+    let rest = model
+        .equilibrium(&PoseRule::new(p, hold))
+        .map_err(|e| fail(e.to_string()))?;
+    model.lock_reels(true);
+    let named = cdpr_bench::analysis::rest_modes::rest_modes(
+        &mut model,
+        &rest.state,
+        &vec![0.0; tensions.len()],
+    )
+    .map_err(|e| fail(e.to_string()))?;
+    Ok(named
+        .modes
+        .iter()
+        .zip(&named.effector_motion)
+        .map(|(m, motion)| {
+            let norm = motion.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let direction =
+                std::array::from_fn(|k| if norm > 0.0 { motion[k] / norm } else { 0.0 });
+            SpatialMode {
+                linearisation: SpatialLoop::LumpedLockedReels,
+                omega_rad_s: m.mode.omega,
+                growth: m.mode.growth,
+                direction,
+                name: format!("{} #{}", m.kind, m.order),
+            }
+        })
+        .collect())
 }
 
 /// The closed loop's modes at its rest state `y`, from its finite-difference Jacobian.
@@ -175,13 +227,23 @@ fn name(robot: &Robot<3>, direction: [f64; 3]) -> String {
     }
 }
 
+/// The lumped lines' lowest modes the Markdown table lists (modes.json has them all).
+const LUMPED_ROWS: usize = 24;
+
 /// The modes as a Markdown table.
 pub fn markdown(report: &SpatialModes) -> String {
     let mut out = format!(
         "Modes at ({}, {}, {}) m, tensions at rest {:?} N\n\n| linearisation | mode | ω [rad/s] | growth [1/s] | direction (x, y, z) |\n|---|---|---|---|---|\n",
         report.pose[0], report.pose[1], report.pose[2], report.tensions
     );
+    let mut lumped = 0;
     for m in &report.modes {
+        if m.linearisation == SpatialLoop::LumpedLockedReels {
+            lumped += 1;
+            if lumped > LUMPED_ROWS {
+                continue;
+            }
+        }
         out += &format!(
             "| {:?} | {} | {:.4} | {:.4e} | ({:.3}, {:.3}, {:.3}) |\n",
             m.linearisation,
@@ -196,5 +258,11 @@ pub fn markdown(report: &SpatialModes) -> String {
     out += "\nDirections are the effector's part of each eigenvector, by magnitude; modes of one \
             frequency repeated (a controller with equal gains on every axis) share their span, \
             so their directions and names are any in it.\n";
+    if lumped > LUMPED_ROWS {
+        out += &format!(
+            "\nThe lumped lines' lowest {LUMPED_ROWS} of {lumped} modes are listed; modes.json \
+             has them all.\n"
+        );
+    }
     out
 }

@@ -374,3 +374,38 @@ fn locked_reel_modes_are_the_length_controlled_loops() {
         assert!((a - b).abs() < 1e-6 * a, "{locked:?} against {closed:?}");
     }
 }
+
+/// The modes study on lumped lines adds every mode of the robot at rest with its reels locked,
+/// named and in ascending order: the effector's three and each cable's string families (across
+/// and in its vertical plane; the plumb line under the ceiling anchor has two in-plane ones).
+/// Their values are checked against closed forms in verify/tests/lumped_spatial.rs.
+#[test]
+fn the_lumped_lines_modes_are_listed_by_name() {
+    let dir = TempDir::new("spatial-modes-lumped");
+    let text = std::fs::read_to_string(example("hangprinter-lumped.toml")).unwrap();
+    let report = modes(&dir, &text, "0,0,0");
+    let lumped: Vec<&serde_json::Value> = report["modes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["linearisation"] == "lumped-locked-reels")
+        .collect();
+    let names: Vec<&str> = lumped.iter().map(|m| m["name"].as_str().unwrap()).collect();
+    for expected in [
+        "effector x #1",
+        "effector y #1",
+        "effector vertical #1",
+        "out-of-plane string cable 1 #1",
+        "in-plane string cable 1 #1",
+        "out-of-plane string cable 3 #1",
+        "in-plane string cable 4 #2",
+        "axial cable 2 #1",
+    ] {
+        assert!(names.contains(&expected), "no {expected}: {names:?}");
+    }
+    let omega: Vec<f64> = lumped
+        .iter()
+        .map(|m| m["omega_rad_s"].as_f64().unwrap())
+        .collect();
+    assert!(omega.windows(2).all(|w| w[0] <= w[1]), "{omega:?}");
+}

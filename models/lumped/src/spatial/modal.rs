@@ -5,10 +5,10 @@ use super::LumpedSpatial;
 use cdpr_core::modal_layout::{Dof, ModalLayout};
 
 impl LumpedSpatial {
-    /// The effector and each free node with its cable's tangent; a stored node moves material
-    /// along its reel line, listed as the coordinate on which r_i is largest with the other two
-    /// frozen — exact for reel lines along an axis (the spatial modes study runs the elastic
-    /// model; this layout serves a modal analysis of hand-built states).
+    /// The effector and each free node with its cable's tangent; a stored node on a locked (or
+    /// driven) reel held, all three coordinates frozen (the spatial modes study's case); on a
+    /// reel pulled by tension it moves material along its reel line, listed as the coordinate on
+    /// which r_i is largest with the other two frozen — exact for reel lines along an axis.
     pub(super) fn modal_layout_of(&self, y: &[f64]) -> ModalLayout {
         let n = self.elements;
         let mut layout = ModalLayout {
@@ -22,8 +22,14 @@ impl LumpedSpatial {
             let r = self.stored[cable];
             let reel = self.reels[cable];
             let along = reel.iamax();
+            let held = self.drive != super::reel::ReelDrive::Tension;
             for j in 0..n {
-                if j < r {
+                if j < r && held {
+                    // A locked (or driven) reel holds its stored line.
+                    layout
+                        .frozen
+                        .extend((0..3).map(|axis| self.index(cable, j, axis)));
+                } else if j < r {
                     for axis in (0..3).filter(|&a| a != along) {
                         layout.frozen.push(self.index(cable, j, axis));
                     }
