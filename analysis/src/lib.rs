@@ -37,6 +37,10 @@ pub enum AnalysisError {
     Modal(#[from] ModalError),
     #[error("no oscillatory closed-loop mode found")]
     NoMode,
+    /// The sparse shift-invert eigen-solve failed (a singular K − ω²M at the shift, or the
+    /// Lanczos iteration).
+    #[error("sparse eigen-solve near the shift: {0}")]
+    Sparse(String),
     /// The model offers no second-order form to read its mass and stiffness from.
     #[error("the model offers no second-order form (mass and stiffness matrices)")]
     NoSecondOrder,

@@ -9,14 +9,17 @@
 //! the coordinates the model's layout leaves free. K is symmetric for conservative forces; its
 //! asymmetry is reported, the symmetric part solved, and the frequencies come out in ascending
 //! order. The dense self-adjoint eigen-solve costs O(n³): it is bounded by
-//! [`crate::linearise::DENSE_MAX_STATES`].
+//! [`crate::linearise::DENSE_MAX_STATES`]. At any size, [`rest_modes_near`] finds the modes
+//! nearest a chosen frequency by shift-invert Lanczos ([`cdpr_numerics::lanczos`]) on the
+//! sparse K − ω_s² M, factorised once by the implicit path's sparse LU.
 
 use crate::AnalysisError;
 use crate::linearise::DENSE_MAX_STATES;
 use crate::modes::{ClassifiedMode, classify};
-use cdpr_core::modal_layout::Dof;
+use cdpr_core::modal_layout::{Dof, ModalLayout};
 use cdpr_core::model::CableModel;
 use cdpr_numerics::eigen::Mode;
+use cdpr_numerics::sparse::IterationMatrix;
 use faer::{Mat, Side};
 
 /// The named modes of a robot at rest.
@@ -27,8 +30,9 @@ pub struct RestModes {
     /// Per mode, the effector's displacement in its shape (mass-normalised, one component per
     /// axis; empty without an effector in the layout).
     pub effector_motion: Vec<Vec<f64>>,
-    /// max |K − Kᵀ| / max |K| of the mass-scaled stiffness (round-off for conservative forces).
-    pub asymmetry: f64,
+    /// max |K − Kᵀ| / max |K| of the mass-scaled stiffness (round-off for conservative forces;
+    /// None from the sparse solve, which does not form K).
+    pub asymmetry: Option<f64>,
 }
 
 /// The modes of `model` at rest in `state` (its velocities zero), the commanded `tensions` [N]
@@ -82,6 +86,31 @@ pub fn rest_modes<M: CableModel<D>, const D: usize>(
         .self_adjoint_eigen(Side::Lower)
         .map_err(AnalysisError::Eigen)?;
     let (values, vectors) = (evd.S().column_vector(), evd.U());
+    let pairs = (0..keep.len()).map(|e| {
+        let shape: Vec<f64> = (0..keep.len()).map(|row| vectors[(row, e)]).collect();
+        (values[e], shape)
+    });
+    let (modes, effector_motion) = named(&layout, &keep, &m, pairs);
+    Ok(RestModes {
+        modes,
+        effector_motion,
+        asymmetry: Some(if largest > 0.0 {
+            asymmetry / largest
+        } else {
+            0.0
+        }),
+    })
+}
+
+/// The modes of `pairs` (eigenvalue ω², eigenvector of M^(−1/2) K M^(−1/2) over `keep`), in the
+/// given order, each classified on `layout` and numbered within its kind, and each one's effector
+/// motion.
+fn named(
+    layout: &ModalLayout,
+    keep: &[usize],
+    m: &[f64],
+    pairs: impl Iterator<Item = (f64, Vec<f64>)>,
+) -> (Vec<ClassifiedMode>, Vec<Vec<f64>>) {
     let effector: Vec<usize> = layout
         .dofs
         .iter()
@@ -90,35 +119,91 @@ pub fn rest_modes<M: CableModel<D>, const D: usize>(
             _ => None,
         })
         .unwrap_or_default();
-    let mut effector_motion = Vec::with_capacity(keep.len());
-    let mut modes = Vec::with_capacity(keep.len());
+    let mut modes = Vec::new();
+    let mut effector_motion = Vec::new();
     let mut counts = std::collections::HashMap::new();
-    let mut u = vec![(0.0, 0.0); n];
-    for e in 0..keep.len() {
+    let mut u = vec![(0.0, 0.0); m.len()];
+    for (value, shape) in pairs {
         for (row, &i) in keep.iter().enumerate() {
-            u[i] = (vectors[(row, e)] / m[i].sqrt(), 0.0);
+            u[i] = (shape[row] / m[i].sqrt(), 0.0);
         }
-        let (kind, purity) = classify(&layout, &u);
+        let (kind, purity) = classify(layout, &u);
         effector_motion.push(effector.iter().map(|&k| u[k].0).collect());
         let order = counts.entry(kind).or_insert(0);
         *order += 1;
         modes.push(ClassifiedMode {
             mode: Mode {
                 growth: 0.0,
-                omega: values[e].max(0.0).sqrt(),
+                omega: value.max(0.0).sqrt(),
             },
             kind,
             order: *order,
             purity,
         });
     }
-    Ok(RestModes {
-        modes,
-        effector_motion,
-        asymmetry: if largest > 0.0 {
-            asymmetry / largest
-        } else {
-            0.0
+    (modes, effector_motion)
+}
+
+/// The `count` modes of `model` at rest in `state` nearest `omega` [rad/s] (numbered within
+/// their kinds among those found), at any size: K − ω²M assembled from the model's sparse
+/// iteration matrix S(c_q) = M + c_q K at c_q = −1/ω² (S = −(K − ω² M)/ω²), factorised once,
+/// and shift-invert Lanczos on M^(−1/2) K M^(−1/2) over the free coordinates (a frozen
+/// coordinate's row of S is its mass alone, so a solve leaves it at zero). `steps` Lanczos
+/// steps bound the work (each one solve); the pairs' residuals are in `residuals`.
+pub fn rest_modes_near<M: CableModel<D>, const D: usize>(
+    model: &mut M,
+    state: &[f64],
+    tensions: &[f64],
+    (omega, count, steps): (f64, usize, usize),
+) -> Result<(RestModes, Vec<f64>), AnalysisError> {
+    let layout = model.modal_layout(state);
+    let form = model
+        .second_order_mut()
+        .ok_or(AnalysisError::NoSecondOrder)?;
+    let n = form.dofs();
+    let pattern = form.iteration_pattern();
+    let qdd = vec![0.0; n];
+    let shift = omega * omega;
+    let (mut shifted, mut mass) = (vec![0.0; pattern.len()], vec![0.0; pattern.len()]);
+    form.iteration_matrix(state, &qdd, tensions, 0.0, -1.0 / shift, &mut shifted);
+    form.iteration_matrix(state, &qdd, tensions, 0.0, 0.0, &mut mass);
+    let mut m = vec![0.0; n];
+    for (e, &(row, col)) in pattern.iter().enumerate() {
+        if row == col {
+            m[row] += mass[e];
+        }
+    }
+    let sparse = |e: cdpr_numerics::sparse::SparseError| AnalysisError::Sparse(e.to_string());
+    let mut lu = IterationMatrix::new(n, &pattern).map_err(sparse)?;
+    lu.factorise(&shifted).map_err(sparse)?;
+    let keep: Vec<usize> = (0..n).filter(|i| !layout.frozen.contains(i)).collect();
+    let mut rhs = vec![0.0; n];
+    // (A − ω² I)⁻¹ y = M^(1/2) (K − ω² M)⁻¹ M^(1/2) y, and (K − ω² M)⁻¹ = −S⁻¹/ω².
+    let solve = |y: &[f64], out: &mut [f64]| {
+        rhs.fill(0.0);
+        for (row, &i) in keep.iter().enumerate() {
+            rhs[i] = m[i].sqrt() * y[row];
+        }
+        lu.solve_in_place(&mut rhs);
+        for (row, &i) in keep.iter().enumerate() {
+            out[row] = -m[i].sqrt() * rhs[i] / shift;
+        }
+    };
+    let pairs = cdpr_numerics::lanczos::nearest(keep.len(), shift, count, steps, solve)
+        .map_err(|e| AnalysisError::Sparse(e.to_string()))?;
+    let residuals = pairs.iter().map(|p| p.residual).collect();
+    let (modes, effector_motion) = named(
+        &layout,
+        &keep,
+        &m,
+        pairs.into_iter().map(|p| (p.value, p.vector)),
+    );
+    Ok((
+        RestModes {
+            modes,
+            effector_motion,
+            asymmetry: None,
         },
-    })
+        residuals,
+    ))
 }

@@ -37,6 +37,7 @@ pub mod differences;
 pub mod dopri5;
 pub mod eigen;
 pub mod generalized_alpha;
+pub mod lanczos;
 pub mod newton;
 pub mod norms;
 pub mod ode;

@@ -86,7 +86,15 @@ pub fn at_pose(scenario: &Scenario, pose: [f64; 3]) -> Result<SpatialModes> {
     let config = cdpr_bench::ModelConfig::from_scenario(scenario)?;
     if config.kind == cdpr_bench::ModelKind::Lumped && robot.cables() > 2 {
         let elements = config.lumped().map_err(cdpr_bench::Error::from)?.elements;
-        modes.extend(lumped_locked_modes(scenario, elements, &p, &tensions)?);
+        let locked = modes
+            .iter()
+            .filter(|m| m.linearisation == SpatialLoop::LockedReels)
+            .map(|m| m.omega_rad_s);
+        let (low, high) = locked.fold((f64::INFINITY, 0.0f64), |(l, h), w| (l.min(w), h.max(w)));
+        let centre = (low * high).sqrt();
+        modes.extend(lumped_locked_modes(
+            scenario, elements, &p, &tensions, centre,
+        )?);
     }
     Ok(SpatialModes {
         pose,
@@ -136,13 +144,18 @@ fn open_loop_modes(robot: &Robot<3>, p: &Vector<3>, tensions: &[f64], ea: f64) -
 }
 
 /// Every mode of the scenario's lumped lines of `elements` springs at rest at `p` [m] under
-/// `tensions` [N], reels then locked, each named (`cdpr_analysis::rest_modes`).
+/// `tensions` [N], reels then locked, each named (`cdpr_analysis::rest_modes`); beyond the
+/// dense solve's size, the [`SPARSE_MODES`] nearest `centre` [rad/s] (the elastic lines'
+/// locked effector modes), by shift-invert.
 fn lumped_locked_modes(
     scenario: &Scenario,
     elements: usize,
     p: &Vector<3>,
     tensions: &[f64],
+    centre: f64,
 ) -> Result<Vec<SpatialMode>> {
+    use cdpr_bench::analysis::AnalysisError;
+    use cdpr_bench::analysis::rest_modes::{rest_modes, rest_modes_near};
     use cdpr_bench::core::model::{CableModel, PoseRule};
     let fail = |e: String| StudyError::Failed(format!("lumped modes at {:?} m: {e}", p.as_slice()));
     let mut model = cdpr_bench::lumped::spatial::LumpedSpatial::from_scenario(scenario, elements)
@@ -152,11 +165,14 @@ fn lumped_locked_modes(
         .equilibrium(&PoseRule::new(p, hold))
         .map_err(|e| fail(e.to_string()))?;
     model.lock_reels(true);
-    let named = cdpr_bench::analysis::rest_modes::rest_modes(
-        &mut model,
-        &rest.state,
-        &vec![0.0; tensions.len()],
-    )
+    let none = vec![0.0; tensions.len()];
+    let named = match rest_modes(&mut model, &rest.state, &none) {
+        Err(AnalysisError::TooLarge { .. }) => {
+            rest_modes_near(&mut model, &rest.state, &none, (centre, SPARSE_MODES, 80))
+                .map(|(named, _)| named)
+        }
+        other => other,
+    }
     .map_err(|e| fail(e.to_string()))?;
     Ok(named
         .modes
@@ -226,6 +242,9 @@ fn name(robot: &Robot<3>, direction: [f64; 3]) -> String {
         "horizontal (y)".into()
     }
 }
+
+/// How many modes the sparse solve finds around the effector's when the dense one is too large.
+const SPARSE_MODES: usize = 12;
 
 /// The lumped lines' lowest modes the Markdown table lists (modes.json has them all).
 const LUMPED_ROWS: usize = 24;
