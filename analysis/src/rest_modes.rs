@@ -18,6 +18,7 @@ use crate::linearise::DENSE_MAX_STATES;
 use crate::modes::{ClassifiedMode, classify};
 use cdpr_core::modal_layout::{Dof, ModalLayout};
 use cdpr_core::model::CableModel;
+use cdpr_core::second_order::SecondOrderForm;
 use cdpr_numerics::eigen::Mode;
 use cdpr_numerics::sparse::IterationMatrix;
 use faer::{Mat, Side};
@@ -33,6 +34,38 @@ pub struct RestModes {
     /// max |K − Kᵀ| / max |K| of the mass-scaled stiffness (round-off for conservative forces;
     /// None from the sparse solve, which does not form K).
     pub asymmetry: Option<f64>,
+}
+
+/// The dense stiffness K = −∂F/∂q [N/m] and the diagonal of the mass M [kg] of a second-order
+/// form at rest in `state` under `tensions` [N]: S(c_q = 1) − S(0) and the diagonal of S(0) of
+/// its iteration matrix (q' = 0, q'' = 0, damping off).
+pub fn stiffness_and_mass(
+    form: &mut dyn SecondOrderForm,
+    state: &[f64],
+    tensions: &[f64],
+) -> (Mat<f64>, Vec<f64>) {
+    let n = form.dofs();
+    let pattern = form.iteration_pattern();
+    let qdd = vec![0.0; n];
+    let (mut stiff, mut mass) = (vec![0.0; pattern.len()], vec![0.0; pattern.len()]);
+    form.iteration_matrix(state, &qdd, tensions, 0.0, 1.0, &mut stiff);
+    form.iteration_matrix(state, &qdd, tensions, 0.0, 0.0, &mut mass);
+    let mut k = Mat::<f64>::zeros(n, n);
+    for (e, &(row, col)) in pattern.iter().enumerate() {
+        k[(row, col)] += stiff[e] - mass[e];
+    }
+    (k, diagonal(&pattern, &mass, n))
+}
+
+/// The diagonal of an n × n matrix given by its `pattern` and entry `values` (duplicates summed).
+fn diagonal(pattern: &[(usize, usize)], values: &[f64], n: usize) -> Vec<f64> {
+    let mut d = vec![0.0; n];
+    for (&(row, col), v) in pattern.iter().zip(values) {
+        if row == col {
+            d[row] += v;
+        }
+    }
+    d
 }
 
 /// The modes of `model` at rest in `state` (its velocities zero), the commanded `tensions` [N]
@@ -53,19 +86,7 @@ pub fn rest_modes<M: CableModel<D>, const D: usize>(
             limit: DENSE_MAX_STATES,
         });
     }
-    let pattern = form.iteration_pattern();
-    let qdd = vec![0.0; n];
-    let (mut stiff, mut mass) = (vec![0.0; pattern.len()], vec![0.0; pattern.len()]);
-    form.iteration_matrix(state, &qdd, tensions, 0.0, 1.0, &mut stiff);
-    form.iteration_matrix(state, &qdd, tensions, 0.0, 0.0, &mut mass);
-    let mut k = Mat::<f64>::zeros(n, n);
-    let mut m = vec![0.0; n];
-    for (e, &(row, col)) in pattern.iter().enumerate() {
-        k[(row, col)] += stiff[e] - mass[e];
-        if row == col {
-            m[row] += mass[e];
-        }
-    }
+    let (k, m) = stiffness_and_mass(form, state, tensions);
     let keep: Vec<usize> = (0..n).filter(|i| !layout.frozen.contains(i)).collect();
     let scaled = Mat::from_fn(keep.len(), keep.len(), |r, c| {
         let (i, j) = (keep[r], keep[c]);
@@ -167,12 +188,7 @@ pub fn rest_modes_near<M: CableModel<D>, const D: usize>(
     let (mut shifted, mut mass) = (vec![0.0; pattern.len()], vec![0.0; pattern.len()]);
     form.iteration_matrix(state, &qdd, tensions, 0.0, -1.0 / shift, &mut shifted);
     form.iteration_matrix(state, &qdd, tensions, 0.0, 0.0, &mut mass);
-    let mut m = vec![0.0; n];
-    for (e, &(row, col)) in pattern.iter().enumerate() {
-        if row == col {
-            m[row] += mass[e];
-        }
-    }
+    let m = diagonal(&pattern, &mass, n);
     let sparse = |e: cdpr_numerics::sparse::SparseError| AnalysisError::Sparse(e.to_string());
     let mut lu = IterationMatrix::new(n, &pattern).map_err(sparse)?;
     lu.factorise(&shifted).map_err(sparse)?;

@@ -291,19 +291,7 @@ fn modes_holding(
     use nalgebra::{DMatrix, SymmetricEigen};
     let mut form = model.clone();
     let n = form.dofs();
-    let pattern = form.iteration_pattern();
-    let qdd = vec![0.0; n];
-    let (mut stiff, mut mass) = (vec![0.0; pattern.len()], vec![0.0; pattern.len()]);
-    form.iteration_matrix(rest, &qdd, &[0.0; 4], 0.0, 1.0, &mut stiff);
-    form.iteration_matrix(rest, &qdd, &[0.0; 4], 0.0, 0.0, &mut mass);
-    let mut k = DMatrix::<f64>::zeros(n, n);
-    let mut m = vec![0.0; n];
-    for (e, &(row, col)) in pattern.iter().enumerate() {
-        k[(row, col)] += stiff[e] - mass[e];
-        if row == col {
-            m[row] += mass[e];
-        }
-    }
+    let (k, m) = cdpr_bench::analysis::rest_modes::stiffness_and_mass(&mut form, rest, &[0.0; 4]);
     let keep: Vec<usize> = (0..n).filter(|i| !held.contains(i)).collect();
     let scaled = DMatrix::from_fn(keep.len(), keep.len(), |r, c| {
         let (i, j) = (keep[r], keep[c]);

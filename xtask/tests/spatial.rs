@@ -164,19 +164,11 @@ fn hangprinter_move_on_lumped_lines_writes_its_cable_channels() {
 fn flex_error_writes_a_consistent_record() {
     let dir = TempDir::new("flex-error");
     let out = dir.join("out");
-    let run = Command::new(env!("CARGO_BIN_EXE_xtask"))
-        .args([
-            "flex-error",
-            "--box=-4,4,-3,3,0.5,3.5",
-            "--points",
-            "2",
-            "--scenario",
-        ])
-        .arg(example("cogiro-lumped.toml"))
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let run = xtask(
+        &["flex-error", "--box=-4,4,-3,3,0.5,3.5", "--points", "2"],
+        &example("cogiro-lumped.toml"),
+        &out,
+    );
     assert!(
         run.status.success(),
         "{}",
@@ -205,13 +197,11 @@ fn flex_error_writes_a_consistent_record() {
         "{table}"
     );
     let upside_down = dir.join("upside-down");
-    let refused = Command::new(env!("CARGO_BIN_EXE_xtask"))
-        .args(["flex-error", "--box=4,-4,-3,3,0.5,3.5", "--scenario"])
-        .arg(example("cogiro-lumped.toml"))
-        .arg("--out")
-        .arg(&upside_down)
-        .output()
-        .unwrap();
+    let refused = xtask(
+        &["flex-error", "--box=4,-4,-3,3,0.5,3.5"],
+        &example("cogiro-lumped.toml"),
+        &upside_down,
+    );
     assert!(!refused.status.success());
     assert!(String::from_utf8_lossy(&refused.stderr).contains("--box"));
     assert!(!upside_down.exists());
@@ -299,13 +289,7 @@ fn modes(dir: &Path, scenario_text: &str, at: &str) -> serde_json::Value {
     let path = dir.join("s.toml");
     std::fs::write(&path, scenario_text).unwrap();
     let out = dir.join("modes");
-    let run = Command::new(env!("CARGO_BIN_EXE_xtask"))
-        .args(["modes", "--scenario"])
-        .arg(&path)
-        .args(["--at", at, "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
+    let run = xtask(&["modes", "--at", at], &path, &out);
     assert!(
         run.status.success(),
         "{}",

@@ -299,13 +299,11 @@ impl Lumped {
     /// the free-side share of the straddling spring (uniform strain along it).
     pub fn free_length(&self, y: &[f64], cable: usize) -> f64 {
         let r = self.stored[cable];
-        let free_springs = (self.elements - r) as f64 * self.segment;
-        if r == 0 {
-            return free_springs;
-        }
-        let length = self.spring_length(y, cable, r - 1);
-        let free_part = (self.pulley(cable) - self.node(y, cable, r)).norm();
-        free_springs + self.segment * free_part / length
+        crate::path::free_length(
+            (self.elements, r, self.segment),
+            self.pulley(cable),
+            (r > 0).then(|| (self.node(y, cable, r - 1), self.node(y, cable, r))),
+        )
     }
 
     /// Total mass of the cables [kg] (constant: every node keeps its mass).

@@ -1,6 +1,7 @@
 //! One spring of a lumped cable along its path (MODELS.md §4 eq. 4), in the plane or in space:
 //! its length, its rate and the unit vectors along which it pulls its two ends — over the pulley
-//! for the straddling spring, along the chord for the others.
+//! for the straddling spring, along the chord for the others; and the cable's unstrained length
+//! on the free side of its pulley.
 
 use nalgebra::SVector;
 
@@ -16,6 +17,24 @@ pub(crate) fn path_length<const D: usize>(
         Some(pulley) => (pulley - a).norm() + (pulley - b).norm(),
         None => (b - a).norm(),
     }
+}
+
+/// Unstrained length between the pulley and the effector [m] of a cable of `springs` springs of
+/// unstrained length `segment`, `stored` of its nodes behind the pulley at `pulley`: the free
+/// springs plus the free-side share of the straddling spring (uniform strain along it), whose
+/// stored and free ends are `straddling` (None when no node is stored).
+#[inline]
+pub(crate) fn free_length<const D: usize>(
+    (springs, stored, segment): (usize, usize, f64),
+    pulley: SVector<f64, D>,
+    straddling: Option<(SVector<f64, D>, SVector<f64, D>)>,
+) -> f64 {
+    let free_springs = (springs - stored) as f64 * segment;
+    let Some((behind, free)) = straddling else {
+        return free_springs;
+    };
+    let length = path_length((behind, free), Some(pulley));
+    free_springs + segment * (pulley - free).norm() / length
 }
 
 /// Length λ, rate λ̇ and the unit vectors along which a spring with ends `a`, `b` (velocities

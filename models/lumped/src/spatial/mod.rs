@@ -394,13 +394,9 @@ impl CableModel<3> for LumpedSpatial {
     }
 
     fn drive_reels(&mut self, rates: &PerCable, accelerations: &PerCable) {
-        let mut drive = ([0.0; MAX_CABLES], [0.0; MAX_CABLES]);
-        let m = self.robot.cables();
-        drive.0[..m].copy_from_slice(&rates[..m]);
-        drive.1[..m].copy_from_slice(&accelerations[..m]);
         self.drive = reel::ReelDrive::Length {
-            rates: drive.0,
-            accelerations: drive.1,
+            rates: *rates,
+            accelerations: *accelerations,
         };
     }
 

@@ -24,7 +24,7 @@
 //! still.
 
 use super::LumpedSpatial;
-use cdpr_core::robot::MAX_CABLES;
+use cdpr_core::robot::PerCable;
 use nalgebra::Vector3;
 
 /// Time constant τ of a driven reel's velocity loop [s].
@@ -40,8 +40,8 @@ pub(super) enum ReelDrive {
     /// The stored lines moved so that the free unstrained lengths change at l̇0_i [m/s] by
     /// l̈0_i [m/s²].
     Length {
-        rates: [f64; MAX_CABLES],
-        accelerations: [f64; MAX_CABLES],
+        rates: PerCable,
+        accelerations: PerCable,
     },
 }
 
