@@ -50,38 +50,15 @@ pub fn over_box(
 ) -> Result<FlexError> {
     let model = LumpedSpatial::from_scenario(scenario, elements)
         .map_err(|e| StudyError::Failed(format!("the lumped lines: {e}")))?;
-    let limits = TensionBox {
-        t_min: scenario.controller.t_min.unwrap_or(0.0),
-        t_max: scenario.controller.t_max.unwrap_or(f64::INFINITY),
-    };
-    let at = |k: usize, axis: usize| {
-        let s = if per_axis > 1 {
-            k as f64 / (per_axis - 1) as f64
-        } else {
-            0.5
-        };
-        low[axis] + s * (high[axis] - low[axis])
-    };
-    let targets: Vec<Vector<3>> = (0..per_axis.pow(3))
-        .map(|k| {
-            let (i, j, l) = (k % per_axis, (k / per_axis) % per_axis, k / per_axis.pow(2));
-            Vector::<3>::new(at(i, 0), at(j, 1), at(l, 2))
-        })
-        .collect();
-    let method = scenario.controller.distribution;
+    let targets = grid(low, high, per_axis);
     let rows = crate::pool::map(&targets, |p| -> Result<Option<FlexPoint>> {
         let robot = model.robot();
-        let w = robot.structure_matrix(p);
-        let lift = Vector::<3>::new(0.0, 0.0, robot.effector_mass * robot.gravity);
-        let Ok(d) = distribute(method, &w, &lift, limits) else {
+        let Some(tensions) = rest_tensions(scenario, robot, p) else {
             return Ok(None);
         };
-        if !d.feasible {
-            return Ok(None);
-        }
         let ea = scenario.cable.axial_stiffness();
         let lengths: Vec<f64> = (0..robot.cables())
-            .map(|i| (robot.anchor(i) - p).norm() / (1.0 + d.tensions[i] / ea))
+            .map(|i| (robot.anchor(i) - p).norm() / (1.0 + tensions[i] / ea))
             .collect();
         let (rest, hangs) = rest_with_lengths(&model, p, &lengths).map_err(|e| {
             StudyError::Failed(format!(
@@ -93,7 +70,7 @@ pub fn over_box(
             target: [p.x, p.y, p.z],
             rest: [rest.x, rest.y, rest.z],
             error: (rest - p).norm(),
-            assumed_tensions: d.tensions.iter().copied().collect(),
+            assumed_tensions: tensions,
             held_tensions: hangs.iter().map(|h| h.straddle_tension).collect(),
         }))
     })?;
@@ -115,6 +92,42 @@ pub fn over_box(
         max,
         rms,
     })
+}
+
+/// The `per_axis`³ targets spanning the box `low`–`high` [m], x fastest, then y, then z (one
+/// point per axis: the box's centre).
+pub fn grid(low: [f64; 3], high: [f64; 3], per_axis: usize) -> Vec<Vector<3>> {
+    let at = |k: usize, axis: usize| {
+        let s = if per_axis > 1 {
+            k as f64 / (per_axis - 1) as f64
+        } else {
+            0.5
+        };
+        low[axis] + s * (high[axis] - low[axis])
+    };
+    (0..per_axis.pow(3))
+        .map(|k| {
+            let (i, j, l) = (k % per_axis, (k / per_axis) % per_axis, k / per_axis.pow(2));
+            Vector::<3>::new(at(i, 0), at(j, 1), at(l, 2))
+        })
+        .collect()
+}
+
+/// The scenario's distribution of the effector's weight at `p` [m] within its tension box
+/// [N], or None where no tensions in the box hold it (outside the wrench-feasible workspace).
+pub fn rest_tensions(
+    scenario: &Scenario,
+    robot: &cdpr_bench::core::robot::Robot<3>,
+    p: &Vector<3>,
+) -> Option<Vec<f64>> {
+    let limits = TensionBox {
+        t_min: scenario.controller.t_min.unwrap_or(0.0),
+        t_max: scenario.controller.t_max.unwrap_or(f64::INFINITY),
+    };
+    let w = robot.structure_matrix(p);
+    let lift = Vector::<3>::new(0.0, 0.0, robot.effector_mass * robot.gravity);
+    let d = distribute(scenario.controller.distribution, &w, &lift, limits).ok()?;
+    d.feasible.then(|| d.tensions.iter().copied().collect())
 }
 
 /// The study in Markdown: per height, the largest and the mean error over the targets there.

@@ -12,6 +12,7 @@
 //! | every input shaper on every model | [`shaping`] | `cargo xtask shaping` |
 //! | a spatial robot's modes at a pose, with their directions | [`spatial_modes`] | `cargo xtask modes --at X,Y,Z` |
 //! | a spatial robot's move, every controller × distribution | [`spatial_moves`] | `cargo xtask spatial-moves` |
+//! | what the lines' mass does to a printer: mode maps, flex error, leaderboard in 3-D | [`spatial_printers`] | `cargo xtask spatial` |
 //! | closed- and open-loop modes, the axial-damping sweep | [`modes`] | `cargo xtask modes` |
 //! | effector mass × move time grids | [`sweeps`] | part of the report |
 //!
@@ -30,6 +31,7 @@ pub mod samples;
 pub mod shaping;
 pub mod spatial_modes;
 pub mod spatial_moves;
+pub mod spatial_printers;
 pub mod sweeps;
 
 /// Why a study stopped.

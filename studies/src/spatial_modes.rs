@@ -9,6 +9,7 @@
 
 use crate::{Result, StudyError};
 use cdpr_bench::analysis::linearise::closed_loop_jacobian;
+use cdpr_bench::analysis::modes::ModeKind;
 use cdpr_bench::core::closed_loop::ClosedLoop;
 use cdpr_bench::core::controller::TensionSolver;
 use cdpr_bench::core::robot::{Matrix, Robot, Vector};
@@ -44,6 +45,15 @@ pub struct SpatialMode {
     /// "vertical (z)", "horizontal (x)", "horizontal (y)", "out-of-plane (y)" (two cables in
     /// the plane y = const), or "controller".
     pub name: String,
+    /// The lumped lines' modes: what moves (effector, a cable's string, axial); absent for the
+    /// effector on elastic cables.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kind: Option<ModeKind>,
+    /// The lumped lines' modes: the effector's share of the mode's kinetic energy, M_e |φ_e|²
+    /// of the mass-normalised shape (1 for the effector on massless cables; over all modes the
+    /// shares sum to 3, one per axis).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub effector_share: Option<f64>,
 }
 
 /// `modes.json`.
@@ -137,6 +147,8 @@ fn open_loop_modes(robot: &Robot<3>, p: &Vector<3>, tensions: &[f64], ea: f64) -
                 growth: (-lambda).max(0.0).sqrt(),
                 name: name(robot, direction),
                 direction,
+                kind: None,
+                effector_share: None,
             });
         }
     }
@@ -174,6 +186,7 @@ fn lumped_locked_modes(
         other => other,
     }
     .map_err(|e| fail(e.to_string()))?;
+    let effector_mass = model.robot().effector_mass;
     Ok(named
         .modes
         .iter()
@@ -188,6 +201,8 @@ fn lumped_locked_modes(
                 growth: m.mode.growth,
                 direction,
                 name: format!("{} #{}", m.kind, m.order),
+                kind: Some(m.kind),
+                effector_share: Some(effector_mass * norm * norm),
             }
         })
         .collect())
@@ -221,6 +236,8 @@ fn closed_loop_modes(
                 growth: shape.mode.growth,
                 name: name(robot, direction),
                 direction,
+                kind: None,
+                effector_share: None,
             }
         })
         .collect())

@@ -55,10 +55,15 @@ fn flex_name(flex: FlexCompensation) -> &'static str {
 /// Every controller × every distribution on `scenario`'s move, on every core (rows in the
 /// table's order, whatever the machine).
 pub fn table(scenario: &Scenario) -> Result<Vec<MoveRow>> {
+    table_with(scenario, &DistributionMethod::ALL)
+}
+
+/// Every controller × each of `methods` on `scenario`'s move (rows in that order).
+pub fn table_with(scenario: &Scenario, methods: &[DistributionMethod]) -> Result<Vec<MoveRow>> {
     let mut jobs = Vec::new();
     let massive = cdpr_bench::ModelConfig::from_scenario(scenario)?.kind != ModelKind::Elastic;
     for (name, kind, flex) in controllers() {
-        for method in DistributionMethod::ALL {
+        for &method in methods {
             let mut s = scenario.clone();
             s.controller.kind = kind;
             s.controller.flex_compensation = flex;

@@ -139,6 +139,7 @@ fn run(grid: &Grid, point: &Point, stop: Option<&AtomicBool>, buffer: SeriesBuff
         progress: &mut quiet,
         on_sample: None,
         stop,
+        frames: None,
     };
     if scenario.robot.anchors.is_some() {
         return run_spatial(scenario, &mut observer, buffer);

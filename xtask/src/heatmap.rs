@@ -61,6 +61,19 @@ fn cell_label(labels: &[String], v: f64) -> String {
     }
 }
 
+/// `v` with three significant digits ("0.0123", "4.56", "7.89e-6").
+fn significant(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let exponent = v.abs().log10().floor() as i32;
+    if (-2..3).contains(&exponent) {
+        format!("{v:.*}", (2 - exponent).max(0) as usize)
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
 /// Viridis-like ramp from dark blue (0) to yellow (1).
 fn color(f: f64) -> RGBColor {
     const STOPS: [(f64, [f64; 3]); 5] = [
@@ -180,12 +193,25 @@ impl HeatMap {
             .y_label_area_size(px(50.0))
             .caption(&self.value_name, ("sans-serif", px(12.0)).into_font())
             .build_cartesian_2d(0.0..1.0, lo..hi)?;
+        // Under a decade, powers of ten would leave the bar unlabelled: label values instead.
+        let narrow = hi - lo < 1.0;
+        let label = |v: &f64| {
+            if narrow {
+                significant(10f64.powf(*v))
+            } else {
+                power_label(v)
+            }
+        };
         chart
             .configure_mesh()
             .disable_mesh()
             .disable_x_axis()
-            .y_labels(((hi - lo).ceil() as usize + 1).max(2))
-            .y_label_formatter(&|v| power_label(v))
+            .y_labels(if narrow {
+                6
+            } else {
+                ((hi - lo).ceil() as usize + 1).max(2)
+            })
+            .y_label_formatter(&label)
             .label_style(("sans-serif", px(11.0)).into_font())
             .draw()?;
         let steps = 64;

@@ -6,7 +6,8 @@
 //! - `modes`: closed- and open-loop modes of every model and the axial-damping sweep;
 //! - `control`: every controller on every model on the paper's move → the leaderboard;
 //! - `shaping`: every input shaper on every model with the paper's PID → residuals and robustness;
-//! - `statics-sweep`: the static equilibrium over a grid of starts, counting failures.
+//! - `statics-sweep`: the static equilibrium over a grid of starts, counting failures;
+//! - `spatial`: what the lines' mass does to the Hangprinter-like and CoGiRo-like printers.
 //!
 //! Errors are printed for a person and give a non-zero exit; a failed run keeps its output.
 
@@ -22,11 +23,13 @@ mod print;
 mod print_figures;
 mod print_study;
 mod report;
+mod robot_picture;
 mod shaping;
 mod simulate;
 mod simulate_spatial;
 mod spatial_figures;
 mod spatial_moves;
+mod spatial_report;
 mod statics_sweep;
 mod sweep;
 mod sweep_study;
@@ -245,6 +248,19 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// What the lines' mass does to a printer, for the Hangprinter-like and CoGiRo-like robots
+    /// on lumped lines: over a grid of each build volume the lowest effector modes (elastic and
+    /// lumped) and the lowest string mode, firmware's flex-compensation error; the Hangprinter
+    /// move under every controller on every cable model; maps, 3-D pictures and an animated GIF
+    /// → DIR/spatial.json, DIR/spatial.md and the figures.
+    Spatial {
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Targets per axis of each build volume (the grid has this many cubed).
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(2..=20))]
+        points: u32,
+    },
     /// A parameter study: every point of a grid file (a base scenario and axes over dotted
     /// scenario keys) run metrics-only on all cores → DIR/results.jsonl and DIR/results.csv.
     /// An interrupted sweep resumes; `--shard I/N` runs points i ≡ I (mod N) (a Slurm array
@@ -307,6 +323,9 @@ fn run(command: Command) -> anyhow::Result<()> {
             out,
         } => flex_error::run(&scenario, &bounds, points as usize, elements as usize, &out),
         Command::PrintStudy { out } => print_study::run(&out),
+        Command::Spatial { out, points } => {
+            spatial_report::run(&out, points as usize).map(|section| print!("{section}"))
+        }
         Command::Plan {
             scenario,
             gcode,

@@ -329,6 +329,7 @@ fn run_streamed(
             progress: &mut report,
             on_sample: Some(&mut on_sample),
             stop: Some(&STOP),
+            frames: None,
         };
         cdpr_bench::simulate_print(scenario, prepared, &mut observer)
     };

@@ -155,6 +155,9 @@ fn beyond_the_paper(base: &Scenario, out: &Path) -> Result<String> {
         study_section.push_str(&study.section(&figures));
     }
     study_section.push_str(&printing_section(out)?);
+    // What the lines' mass does to the Hangprinter-like and CoGiRo-like printers (~15 s on two
+    // cores).
+    study_section.push_str(&crate::spatial_report::run(out, SPATIAL_POINTS)?);
     Ok(format!(
         "{}\n## Input shaping with the paper's PID\n\nBeyond the paper (`cargo xtask shaping`; shaping.csv has \
          every run).\n\n{}\n{}",
@@ -163,6 +166,9 @@ fn beyond_the_paper(base: &Scenario, out: &Path) -> Result<String> {
         study_section
     ))
 }
+
+/// Targets per axis of the spatial section's build-volume grids.
+const SPATIAL_POINTS: usize = 5;
 
 /// The printer's speed–accuracy frontier (160 prints of two first layers, ~30 s on two cores):
 /// its files into `out`, its section of REPORT.md returned.

@@ -165,6 +165,7 @@ pub(crate) fn streamed<T>(
             progress: &mut report,
             on_sample: Some(&mut on_sample),
             stop: Some(&STOP),
+            frames: None,
         };
         run(&mut observer)
     };

@@ -95,6 +95,24 @@ fn bad_scenario_is_reported_with_key_and_range() {
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
 
+/// `spatial` refuses a grid it cannot draw (one target per axis) before any work.
+#[test]
+fn spatial_refuses_a_one_point_grid() {
+    let dir = TempDir::new("spatial-points");
+    let output = xtask()
+        .args(["spatial", "--points", "1", "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("--points") && stderr.contains("2..=20"),
+        "{stderr}"
+    );
+    assert!(!dir.join("out").exists(), "nothing written");
+}
+
 #[test]
 fn unknown_models_are_clear_errors() {
     let dir = TempDir::new("model");

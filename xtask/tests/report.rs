@@ -7,8 +7,15 @@ use common::TempDir;
 use std::path::Path;
 use std::process::Command;
 
-const FIGURES: [&str; 10] = [
+const FIGURES: [&str; 17] = [
     "print-frontier",
+    "spatial_hangprinter_modes",
+    "spatial_hangprinter_flex",
+    "spatial_hangprinter_rest",
+    "spatial_hangprinter_move",
+    "spatial_cogiro_modes",
+    "spatial_cogiro_flex",
+    "spatial_cogiro_rest",
     "sweep_z_p2p",
     "sweep_err_transition",
     "sweep_shaper_z_p2p",
@@ -133,6 +140,23 @@ fn report_writes_every_figure_table_and_file() {
         let a = std::fs::read(out.join(format!("{name}.svg"))).unwrap();
         let b = std::fs::read(again_dir.join(format!("out/{name}.svg"))).unwrap();
         assert!(a == b, "{name}.svg differs between runs");
+    }
+    // The spatial section: its study and its animation, the same bytes again.
+    assert!(md.contains("## What the lines' mass does to a printer\n"));
+    let spatial: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("spatial.json")).unwrap()).unwrap();
+    assert_eq!(spatial["printers"].as_array().unwrap().len(), 2);
+    assert_eq!(spatial["leaderboard"].as_array().unwrap().len(), 2);
+    let gif = std::fs::File::open(out.join("spatial_hangprinter_move.gif")).unwrap();
+    let frames = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(gif))
+        .and_then(|d| image::AnimationDecoder::into_frames(d).collect_frames())
+        .unwrap();
+    // The Hangprinter move's 1.2 s, a frame every 0.04 s from t = 0.
+    assert_eq!(frames.len(), 31, "frames of the move's GIF");
+    for name in ["spatial.json", "spatial_hangprinter_move.gif"] {
+        let a = std::fs::read(out.join(name)).unwrap();
+        let b = std::fs::read(again_dir.join("out").join(name)).unwrap();
+        assert!(a == b, "{name} differs between runs");
     }
     let leftovers: Vec<_> = std::fs::read_dir(&out)
         .unwrap()

@@ -397,6 +397,16 @@ pub trait CableModel<const D: usize> {
         })
     }
 
+    /// Each cable's line from its pulley to the effector in `state`, as points [m] (for
+    /// drawings: a massive model's free nodes show the sag and the string motion). By default
+    /// the straight chord from the anchor.
+    fn cable_paths(&self, state: &[f64]) -> Vec<Vec<crate::robot::Vector<D>>> {
+        let effector = self.effector(state).position;
+        (0..self.cables())
+            .map(|i| vec![self.robot().anchor(i), effector])
+            .collect()
+    }
+
     /// Names of the model's own output channels, after the common ones.
     fn channel_names(&self) -> Vec<String>;
 

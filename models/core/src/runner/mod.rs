@@ -4,11 +4,14 @@
 
 mod error;
 mod events;
+mod frames;
 mod sampler;
 
 pub use error::{RunError, RunFailure};
 pub use events::EVENT_TIME_TOL;
 use events::{EventMonitor, check_slack};
+use frames::FrameClock;
+pub use frames::{FrameSink, Frames};
 use sampler::Sampler;
 
 use crate::channel::Channel;
@@ -143,6 +146,8 @@ pub struct Observer<'a> {
     /// When set (e.g. by a signal handler), the run stops after the current step with
     /// [`RunError::Interrupted`], keeping what it sampled.
     pub stop: Option<&'a AtomicBool>,
+    /// When set, receives the cables' lines every `period` (drawings, animations).
+    pub frames: Option<Frames<'a>>,
 }
 
 impl<'a> Observer<'a> {
@@ -152,6 +157,7 @@ impl<'a> Observer<'a> {
             progress,
             on_sample: None,
             stop: None,
+            frames: None,
         }
     }
 
@@ -365,8 +371,10 @@ fn integrate<M: CableModel<D>, const D: usize>(
         .map_err(integrator(0.0))?;
     let mut monitor = EventMonitor::new(sys, y0);
     let mut row = Vec::new();
+    let mut clock = FrameClock::default();
     sampler.sample_through(sys, stepper, 0.0)?;
     observer.emit(&sampler.series, 0, &mut row);
+    clock.take_through(sys, stepper, 0.0, &mut observer.frames);
     while stepper.time() < t_end {
         if observer.stopped() {
             return Err(RunError::Interrupted { t: stepper.time() });
@@ -379,6 +387,7 @@ fn integrate<M: CableModel<D>, const D: usize>(
             let t = stepper.time();
             sampler.sample_through(sys, stepper, t)?;
             observer.emit(&sampler.series, taken, &mut row);
+            clock.take_through(sys, stepper, t, &mut observer.frames);
             check_slack(
                 t,
                 &sys.command(t, stepper.state()).tensions,
@@ -392,6 +401,7 @@ fn integrate<M: CableModel<D>, const D: usize>(
         // there and the integrator restarts from it, abandoning the rest of the step.
         sampler.sample_through(sys, stepper, t_event)?;
         observer.emit(&sampler.series, taken, &mut row);
+        clock.take_through(sys, stepper, t_event, &mut observer.frames);
         let mut y = vec![0.0; y0.len()];
         stepper.dense_output(t_event, &mut y);
         let n = sys.model_len();

@@ -460,6 +460,17 @@ impl CableModel<3> for LumpedSpatial {
         pulley::apply_event(self, index, t, y)
     }
 
+    /// The pulley, then the free nodes r_i … N − 1 and the effector (node N).
+    fn cable_paths(&self, y: &[f64]) -> Vec<Vec<Vector3<f64>>> {
+        (0..self.robot.cables())
+            .map(|c| {
+                std::iter::once(self.pulley(c))
+                    .chain((self.stored[c]..=self.elements).map(|j| self.node(y, c, j)))
+                    .collect()
+            })
+            .collect()
+    }
+
     fn channel_names(&self) -> Vec<String> {
         cdpr_core::channel::Channel::cable_channel_names(self.robot.cables())
     }
