@@ -20,6 +20,7 @@ use cdpr_core::series::SeriesBuffer;
 use cdpr_core::shaper::Impulses;
 use cdpr_core::trajectory::Segment;
 use cdpr_elastic::Elastic;
+use cdpr_fe::spatial::FeSpatial;
 use cdpr_lumped::spatial::LumpedSpatial;
 
 /// Instants of the reference checked for feasibility over the move (plus its start and end).
@@ -85,17 +86,16 @@ pub(crate) fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Er
     match config.kind {
         ModelKind::Elastic => cdpr_elastic::Params {}.validate(scenario)?,
         ModelKind::Lumped => check_lumped(scenario, &robot)?,
-        ModelKind::Fe => {
-            return Err(out_of_range(
-                "model.kind",
-                "\"fe\" with robot.anchors",
-                "\"elastic\" or \"lumped\": the FE cables are planar so far",
-            )
-            .into());
-        }
+        ModelKind::Fe => check_fe(scenario, &robot)?,
     }
-    if config.kind == ModelKind::Lumped {
-        lumped_model(scenario, &config)?;
+    match config.kind {
+        ModelKind::Lumped => {
+            lumped_model(scenario, &config)?;
+        }
+        ModelKind::Fe => {
+            fe_model(scenario, &config)?;
+        }
+        ModelKind::Elastic => {}
     }
     Ok((robot, config.kind))
 }
@@ -125,6 +125,71 @@ fn check_lumped(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
         );
     }
     Ok(())
+}
+
+/// What the spatial FE cables run so far: three or more cables on reels pulled by tension, on
+/// DOPRI5 (the second-order form of the star, reels driven by length and the rigid stored cable
+/// are planar only).
+fn check_fe(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
+    use cdpr_core::scenario::{ControllerKind, IntegratorKind};
+    let refuse = |key: &'static str, value: String, allowed: &str| -> Result<(), Error> {
+        Err(out_of_range(key, value, allowed.to_owned()).into())
+    };
+    if robot.cables() < 3 {
+        return refuse(
+            "robot.anchors",
+            format!("{} anchors with model.kind = \"fe\"", robot.cables()),
+            "3 to 8 anchors for the spatial FE cables (two cables in space run elastic)",
+        );
+    }
+    if scenario.controller.kind == ControllerKind::Length {
+        return refuse(
+            "controller.kind",
+            "\"length\" with model.kind = \"fe\" and robot.anchors".into(),
+            "a tension controller (pid, pid-xz, computed-torque, lqr): reels driven by length \
+             on FE cables in space (MODELS.md FE.11.10's prescribed length) are not built yet; \
+             the lumped lines follow lengths",
+        );
+    }
+    if scenario.simulation.integrator == IntegratorKind::Implicit {
+        return refuse(
+            "simulation.integrator",
+            "\"implicit\" with model.kind = \"fe\" and robot.anchors".into(),
+            "\"dopri5\": the spatial FE cables have no second-order form for the implicit path \
+             yet",
+        );
+    }
+    Ok(())
+}
+
+/// The spatial FE model of `scenario` (its `[model]` keys), its modelled length checked against
+/// the move: 1.05 (1 + t_max/EA) times the longest chord from a pulley to the move's start or
+/// end (the chord to a straight segment is longest at one of its ends), as the lumped lines'.
+pub(crate) fn fe_model(scenario: &Scenario, config: &ModelConfig) -> Result<FeSpatial, Error> {
+    let model = FeSpatial::from_scenario(scenario, config.fe()?)?;
+    if let Ok((start, end)) = scenario.trajectory.spatial_move() {
+        let t_max = scenario.controller.t_max.unwrap_or(0.0);
+        let chord = [start, end]
+            .iter()
+            .flat_map(|p| {
+                let p = Vector::from(*p);
+                model.robot().anchors().iter().map(move |a| (a - p).norm())
+            })
+            .fold(0.0, f64::max);
+        let needed = 1.05 * (1.0 + t_max / model.material.ea) * chord;
+        if model.modelled_length < needed {
+            return Err(out_of_range(
+                "cable.modelled_length",
+                model.modelled_length.to_string(),
+                format!(
+                    "≥ {needed:.6} m for this move (1.05 × (1 + t_max/EA) × longest chord \
+                     {chord:.6} m)"
+                ),
+            )
+            .into());
+        }
+    }
+    Ok(model)
 }
 
 /// The spatial lumped model of `scenario` (its `[model] elements`).
@@ -255,13 +320,13 @@ pub(crate) fn with_spatial_model<V: SpatialVisitor>(
     visitor: V,
 ) -> Result<V::Output, Error> {
     let (robot, kind) = run_robot(scenario)?;
-    if kind == ModelKind::Lumped {
-        visitor.visit(lumped_model(
+    match kind {
+        ModelKind::Lumped => visitor.visit(lumped_model(
             scenario,
             &ModelConfig::from_scenario(scenario)?,
-        )?)
-    } else {
-        visitor.visit(Elastic::new(robot, scenario.cable.axial_stiffness()))
+        )?),
+        ModelKind::Fe => visitor.visit(fe_model(scenario, &ModelConfig::from_scenario(scenario)?)?),
+        ModelKind::Elastic => visitor.visit(Elastic::new(robot, scenario.cable.axial_stiffness())),
     }
 }
 

@@ -518,7 +518,8 @@ fn bad_spatial_input_is_refused_by_name() {
         "[trajectory]\nend = [0.3, 0.2, 0.2]\nt2 = 0.05",
         "wrench-feasible",
     );
-    refuse("[model]\nkind = \"fe\"", "model.kind");
+    // FE cables in space: the line must cover the move (here 1 m against 2.3 m chords).
+    refuse("[model]\nkind = \"fe\"", "cable.modelled_length");
     refuse("[model]\nkind = \"lumped\"", "cable.modelled_length");
     refuse(
         "[model]\nkind = \"lumped\"\nelements = 2\n[cable]\nmodelled_length = 3.2",

@@ -228,7 +228,11 @@ fn spatial_runs_are_refused_before_any_file() {
 
     for (file, text, expected) in [
         ("fast.toml", fast, "wrench-feasible workspace at t ="),
-        ("fe.toml", model("kind = \"fe\""), "model.kind"),
+        (
+            "fe.toml",
+            long(model("kind = \"fe\"")).replace("\"computed-torque\"", "\"length\""),
+            "controller.kind",
+        ),
         (
             "short.toml",
             model("kind = \"lumped\""),

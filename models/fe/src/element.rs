@@ -12,7 +12,14 @@
 //! element's rows of eq. 12, m q'' + c q' + k q = f + f_g, as M_e and F_e (FE.5.3).
 
 use crate::params::FeMass;
-use nalgebra::Vector2;
+use nalgebra::SVector;
+
+/// The vertical vector (0, …, 0, v): gravity acts along the last axis (z in the plane and in
+/// space).
+#[inline(always)]
+fn vertical<const D: usize>(v: f64) -> SVector<f64, D> {
+    SVector::<f64, D>::from_fn(|k, _| if k == D - 1 { v } else { 0.0 })
+}
 
 /// Element mass coefficients c1, c2, α, β, γ of MODELS.md FE.4 for weights (w_a, w_b).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,23 +72,23 @@ pub struct Material {
 /// divides once and every element multiplies (divisions and square roots share one slow unit, and
 /// they were most of an element's cost). Build it with [`ElementState::new`] unless 1/h is at hand.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ElementState {
-    pub ra: Vector2<f64>,
-    pub rb: Vector2<f64>,
-    pub va: Vector2<f64>,
-    pub vb: Vector2<f64>,
+pub struct ElementState<const D: usize = 2> {
+    pub ra: SVector<f64, D>,
+    pub rb: SVector<f64, D>,
+    pub va: SVector<f64, D>,
+    pub vb: SVector<f64, D>,
     pub l_rate: f64,
     pub h: f64,
     pub inv_h: f64,
     pub h_prime: f64,
 }
 
-impl ElementState {
+impl<const D: usize> ElementState<D> {
     /// Nodes (r_a, v_a), (r_b, v_b), the span's l', unstrained length h and h'.
     #[inline]
     pub fn new(
-        (ra, va): (Vector2<f64>, Vector2<f64>),
-        (rb, vb): (Vector2<f64>, Vector2<f64>),
+        (ra, va): (SVector<f64, D>, SVector<f64, D>),
+        (rb, vb): (SVector<f64, D>, SVector<f64, D>),
         l_rate: f64,
         h: f64,
         h_prime: f64,
@@ -115,32 +122,36 @@ impl ElementState {
 
 /// What an element adds to M and F (FE.5.3), in its local unknowns (r_a, r_b, l).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ElementTerms {
+pub struct ElementTerms<const D: usize = 2> {
     /// μ h c1: the r_a r_a and r_b r_b blocks (times I2) [kg].
     pub m_diag: f64,
     /// μ h c2: the r_a r_b block (times I2) [kg].
     pub m_off: f64,
     /// μ α Δ, μ β Δ: the r_a l and r_b l columns [kg].
-    pub m_al: Vector2<f64>,
-    pub m_bl: Vector2<f64>,
+    pub m_al: SVector<f64, D>,
+    pub m_bl: SVector<f64, D>,
     /// μ γ |Δ|²/h: the l l entry [kg].
     pub m_ll: f64,
     /// Generalised forces F_a, F_b [N] and F_l [N] (FE.5.3), gravity included.
-    pub fa: Vector2<f64>,
-    pub fb: Vector2<f64>,
+    pub fa: SVector<f64, D>,
+    pub fb: SVector<f64, D>,
     pub fl: f64,
 }
 
 /// M_e and F_e of MODELS.md FE.5.3 for one element (no axial damping).
 #[inline]
-pub fn terms(mat: &Material, k: &MassCoefficients, s: &ElementState) -> ElementTerms {
+pub fn terms<const D: usize>(
+    mat: &Material,
+    k: &MassCoefficients,
+    s: &ElementState<D>,
+) -> ElementTerms<D> {
     terms_damped(mat, k, s, 0.0)
 }
 
 /// Strain rate ε' = (t·Δ')/h − (1 + ε) h' l'/h of MODELS.md FE.5.7 [1/s]: the chord's stretching
 /// rate minus the relaxation by unstrained length flowing in.
 #[inline]
-pub fn strain_rate(s: &ElementState) -> f64 {
+pub fn strain_rate<const D: usize>(s: &ElementState<D>) -> f64 {
     let delta = s.rb - s.ra;
     let len = delta.norm();
     let strain = len * s.inv_h - 1.0;
@@ -151,7 +162,11 @@ pub fn strain_rate(s: &ElementState) -> f64 {
 /// N_d = max(EA ε + C ε', 0) − EA ε while taut, else 0. As in the lumped model (MODELS.md §4) the
 /// total tension is clipped at 0, so a fast-shortening taut element cannot push. Returns (N_d, ε').
 #[inline]
-pub fn damping_tension(mat: &Material, s: &ElementState, damping: f64) -> (f64, f64) {
+pub fn damping_tension<const D: usize>(
+    mat: &Material,
+    s: &ElementState<D>,
+    damping: f64,
+) -> (f64, f64) {
     if damping == 0.0 {
         return (0.0, 0.0);
     }
@@ -167,7 +182,7 @@ pub fn damping_tension(mat: &Material, s: &ElementState, damping: f64) -> (f64, 
 /// Power dissipated by the element's axial damping, D_e = h N_d ε' ≥ 0 [W] (FE.5.7: C h ε'² when
 /// not clipped; with clipping N_d = −EA ε < 0 only while ε' < 0, so still ≥ 0).
 #[inline]
-pub fn dissipation(mat: &Material, s: &ElementState, damping: f64) -> f64 {
+pub fn dissipation<const D: usize>(mat: &Material, s: &ElementState<D>, damping: f64) -> f64 {
     let (nd, rate) = damping_tension(mat, s, damping);
     s.h * nd * rate
 }
@@ -185,7 +200,7 @@ pub struct Chord {
 impl Chord {
     /// The chord of element `s`.
     #[inline]
-    pub fn of(s: &ElementState) -> Self {
+    pub fn of<const D: usize>(s: &ElementState<D>) -> Self {
         let length = (s.rb - s.ra).norm();
         Self {
             length,
@@ -213,24 +228,24 @@ pub fn chords(x: &[f64], z: &[f64], length: &mut [f64], inv_length: &mut [f64]) 
 /// h' N_d (1 + ε) to F_l (the virtual work −h N_d δε with δε = t·δΔ/h − (1 + ε) h' δl/h; note
 /// (1 + ε), not the (1 + ε/2) of the elastic term, which comes from the strain energy's h).
 #[inline(always)]
-pub fn terms_damped(
+pub fn terms_damped<const D: usize>(
     mat: &Material,
     k: &MassCoefficients,
-    s: &ElementState,
+    s: &ElementState<D>,
     damping: f64,
-) -> ElementTerms {
+) -> ElementTerms<D> {
     terms_at_chord(mat, k, s, damping, Chord::of(s))
 }
 
 /// [`terms_damped`] with the element's chord given.
 #[inline(always)]
-pub fn terms_at_chord(
+pub fn terms_at_chord<const D: usize>(
     mat: &Material,
     k: &MassCoefficients,
-    s: &ElementState,
+    s: &ElementState<D>,
     damping: f64,
     chord: Chord,
-) -> ElementTerms {
+) -> ElementTerms<D> {
     debug_assert!(
         (s.h * s.inv_h - 1.0).abs() < 1e-12,
         "inv_h out of step with h"
@@ -256,9 +271,9 @@ pub fn terms_at_chord(
         - (a * k.c1 + b * k.c2) * (mu * h_rate)
         - delta_rate * (mu * k.alpha * ld)
         - g
-        - Vector2::new(0.0, half_weight);
+        - vertical::<D>(half_weight);
     let fb = -pull - (a * k.c2 + b * k.c1) * (mu * h_rate) - delta_rate * (mu * k.beta * ld) + g
-        - Vector2::new(0.0, half_weight);
+        - vertical::<D>(half_weight);
     let kinetic_density =
         0.5 * mu * (k.c1 * (a.norm_squared() + b.norm_squared()) + 2.0 * k.c2 * a.dot(&b));
     let ld2_len2_h2 = ld * ld * len2 * inv_h * inv_h;
@@ -269,7 +284,7 @@ pub fn terms_at_chord(
             * (kinetic_density - 0.5 * mu * k.gamma * ld2_len2_h2
                 + n * (1.0 + 0.5 * strain.max(0.0))
                 + n_damp * (1.0 + strain)
-                - mu * mat.gravity * 0.5 * (s.ra.y + s.rb.y));
+                - mu * mat.gravity * 0.5 * (s.ra[D - 1] + s.rb[D - 1]));
     ElementTerms {
         m_diag: mu * h * k.c1,
         m_off: mu * h * k.c2,
@@ -301,16 +316,16 @@ pub fn terms_at_chord(
 /// checks the two agree to round-off.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub fn residual_at_chord(
+pub fn residual_at_chord<const D: usize>(
     mat: &Material,
     k: &MassCoefficients,
-    s: &ElementState,
+    s: &ElementState<D>,
     damping: f64,
     chord: Chord,
-    aa: Vector2<f64>,
-    ab: Vector2<f64>,
+    aa: SVector<f64, D>,
+    ab: SVector<f64, D>,
     al: f64,
-) -> (Vector2<f64>, Vector2<f64>, f64) {
+) -> (SVector<f64, D>, SVector<f64, D>, f64) {
     let mu = mat.mu;
     let (h, ld, inv_h) = (s.h, s.l_rate, s.inv_h);
     let (a, b) = (s.va, s.vb);
@@ -325,7 +340,7 @@ pub fn residual_at_chord(
     let drift = mu * ld * (k.alpha + k.beta);
     let pull = (n + n_damp) * chord.inv_length;
     let centripetal = mu * k.gamma * ld * ld * inv_h;
-    let weight = Vector2::new(0.0, 0.5 * mu * mat.gravity * h);
+    let weight = vertical::<D>(0.5 * mu * mat.gravity * h);
     let ra = (da * k.c1 + db * k.c2) * mu
         + b * drift
         + delta * (mu * k.alpha * al + centripetal - pull)
@@ -344,13 +359,17 @@ pub fn residual_at_chord(
                     + 2.0 * ld * inv_h * delta.dot(&delta_rate)))
         - s.h_prime
             * (kinetic_density + n * (1.0 + 0.5 * strain.max(0.0)) + n_damp * (1.0 + strain)
-                - mu * mat.gravity * 0.5 * (s.ra.y + s.rb.y));
+                - mu * mat.gravity * 0.5 * (s.ra[D - 1] + s.rb[D - 1]));
     (ra, rb, rl)
 }
 
 /// Element energies of MODELS.md FE.4: (kinetic T_e, strain ½ EA h max(ε,0)², gravity
 /// μ g h (z_a + z_b)/2) [J].
-pub fn energies(mat: &Material, k: &MassCoefficients, s: &ElementState) -> (f64, f64, f64) {
+pub fn energies<const D: usize>(
+    mat: &Material,
+    k: &MassCoefficients,
+    s: &ElementState<D>,
+) -> (f64, f64, f64) {
     let mu = mat.mu;
     let (h, ld) = (s.h, s.l_rate);
     let (a, b) = (s.va, s.vb);
@@ -362,13 +381,14 @@ pub fn energies(mat: &Material, k: &MassCoefficients, s: &ElementState) -> (f64,
             + 0.5 * mu * k.gamma * ld * ld * len2 * s.inv_h;
     let strain = (len2.sqrt() * s.inv_h - 1.0).max(0.0);
     let elastic = 0.5 * mat.ea * h * strain * strain;
-    let gravity = mu * mat.gravity * h * 0.5 * (s.ra.y + s.rb.y);
+    let gravity = mu * mat.gravity * h * 0.5 * (s.ra[D - 1] + s.rb[D - 1]);
     (kinetic, elastic, gravity)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Vector2;
     use proptest::prelude::*;
 
     proptest! {

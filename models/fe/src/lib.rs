@@ -29,6 +29,7 @@ mod lanes;
 mod modal;
 pub mod params;
 pub mod solve;
+pub mod spatial;
 mod statics;
 
 use cdpr_core::model::{CableModel, Energy, Equilibrium, ModelError, RestRule};

@@ -25,6 +25,7 @@
 pub mod cables;
 pub mod distribution;
 mod gram;
+pub mod reels;
 pub mod space;
 
 pub use cables::{CableId, MAX_CABLES, PerCable, Tensions};

@@ -81,31 +81,7 @@ pub struct LumpedSpatial {
     implicit: implicit::ImplicitScratch,
 }
 
-/// The default reel direction of each anchor (MODELS.md §11): horizontal, away from the anchors'
-/// centroid — but for an anchor whose horizontal offset from the centroid is smaller than its
-/// vertical one (a ceiling anchor such as Hangprinter's D), vertical, away from the centroid: a
-/// horizontal reel line there would put the anchor's own plumb line on the boundary of the
-/// pulley's side rule.
-pub fn default_reel_directions(anchors: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
-    let centroid = centroid(anchors);
-    anchors
-        .iter()
-        .map(|a| {
-            let away = a - centroid;
-            let horizontal = Vector3::new(away.x, away.y, 0.0);
-            if horizontal.norm() >= away.z.abs() {
-                horizontal.normalize()
-            } else {
-                Vector3::z() * away.z.signum()
-            }
-        })
-        .collect()
-}
-
-/// The anchors' centroid [m], the workspace's middle for the reel directions.
-fn centroid(anchors: &[Vector3<f64>]) -> Vector3<f64> {
-    anchors.iter().sum::<Vector3<f64>>() / anchors.len() as f64
-}
+pub use cdpr_core::robot::reels::default_reel_directions;
 
 impl LumpedSpatial {
     /// The robot's cables lumped, reeled along `reels` (checked not to point into the workspace,
@@ -126,36 +102,14 @@ impl LumpedSpatial {
             });
         }
         let m = robot.cables();
-        if reels.len() != m {
-            return Err(ModelError::Parameter {
-                name: "robot.reel_directions",
-                value: reels.len() as f64,
-                allowed: format!("one direction per anchor ({m})"),
-            });
-        }
-        let centroid = centroid(robot.anchors());
         let mut units = [Vector3::x(); MAX_CABLES];
-        for (i, r) in reels.iter().enumerate() {
-            let norm = r.norm();
-            let away = robot.anchor(i) - centroid;
-            let outward = away.dot(r);
-            let tolerance = -1e-9 * away.norm();
-            if !(norm.is_finite() && norm > 0.0 && outward >= tolerance) {
-                return Err(ModelError::Parameter {
-                    name: "robot.reel_directions",
-                    value: outward,
-                    allowed: format!(
-                        "cable {}: a nonzero direction [{}, {}, {}] not pointing into the \
-                         workspace (its dot product with A_i − the anchors' centroid ≥ 0): the \
-                         reel line must leave the workspace",
-                        i + 1,
-                        r.x,
-                        r.y,
-                        r.z
-                    ),
-                });
-            }
-            units[i] = r / norm;
+        for (unit, r) in units
+            .iter_mut()
+            .zip(cdpr_core::robot::reels::unit_reel_directions(
+                &robot, reels,
+            )?)
+        {
+            *unit = r;
         }
         let segment = cable.modelled_length / n as f64;
         Ok(Self {

@@ -1,0 +1,172 @@
+//! Statics of the spatial FE robot (MODELS.md FE.8.1 at a pose, §11): F(q, 0, T) = 0 with the
+//! effector pinned at the rule's pose and the cables' weight carried by a tension correction
+//! T = T0 + W⁺ δw (the least in the tensions' norm, as the lumped lines'), by the core's Newton
+//! service from the straight-chord guess (nodes on the chords A_i → P, l_i = chord/(1 + T_i/EA),
+//! ρ_i = (L0 − l_i)(1 + T_i/EA)).
+//!
+//! Unknowns: every coordinate of q but the effector's three, then δw (3); equations: every row
+//! of F. The Jacobian is the Newton service's dense central differences: O(n³) per iteration,
+//! so the statics is bounded (N ≤ [`MAX_STATIC_ELEMENTS`] per cable).
+
+use super::FeSpatial;
+use cdpr_core::model::{CableModel, Equilibrium, ModelError, RestRule};
+use cdpr_core::robot::{Matrix, PerCable, StructureMatrix, Tensions, Vector};
+use cdpr_numerics::newton::{self, NewtonOptions, StaticProblem};
+use nalgebra::Vector3;
+
+/// Most elements per cable the dense statics takes (n ≈ 24 N m coordinates: N = 60, m = 8 is
+/// 1 400 unknowns, a few seconds).
+pub const MAX_STATIC_ELEMENTS: usize = 60;
+
+struct Problem<'a> {
+    model: &'a mut FeSpatial,
+    pose: Vector3<f64>,
+    base: Tensions,
+    w: StructureMatrix<3>,
+    gram_inv: Matrix<3>,
+    /// The state being assembled (velocities stay zero) and the forces' scratch.
+    y: Vec<f64>,
+    forces: Vec<f64>,
+    /// Indices in q of the unknown coordinates, in order (δw follows).
+    map: Vec<usize>,
+}
+
+impl Problem<'_> {
+    fn tensions(&self, dw: &[f64]) -> Tensions {
+        let lambda = self.gram_inv * Vector::<3>::new(dw[0], dw[1], dw[2]);
+        PerCable::from_fn(self.base.len(), |i| {
+            self.base[i] + self.w.column(i).dot(&lambda)
+        })
+    }
+
+    fn load(&mut self, u: &[f64]) {
+        for (k, &i) in self.map.iter().enumerate() {
+            self.y[i] = u[k];
+        }
+        for a in 0..3 {
+            let p = self.model.effector_index(a);
+            self.y[p] = self.pose[a];
+        }
+    }
+}
+
+impl StaticProblem for Problem<'_> {
+    fn dimension(&self) -> usize {
+        self.map.len() + 3
+    }
+    fn length_unknowns(&self) -> usize {
+        self.map.len()
+    }
+    /// A tension-only element's stretch T/k is ~1e-5 of its length: steps well inside it.
+    fn scale(&self, i: usize) -> f64 {
+        if i < self.map.len() { 1e-4 } else { 1.0 }
+    }
+    /// The n rows of F(q, 0, T0 + W⁺ δw) [N].
+    fn residual(&mut self, u: &[f64], r: &mut [f64]) {
+        self.load(u);
+        let t = self.tensions(&u[self.map.len()..]);
+        let mut forces = std::mem::take(&mut self.forces);
+        self.model.rest_forces(&self.y, &t, &mut forces);
+        r.copy_from_slice(&forces);
+        self.forces = forces;
+    }
+}
+
+/// The robot at rest at the rule's pose (every coordinate pinned), the tensions corrected by
+/// W⁺ δw to carry the cables' weight.
+pub(super) fn equilibrium(
+    model: &mut FeSpatial,
+    rule: &dyn RestRule<3>,
+) -> Result<Equilibrium, ModelError> {
+    if rule.pinned().len() != 3 {
+        return Err(ModelError::State {
+            t: 0.0,
+            why: "the spatial FE model rests at a pose: all three coordinates pinned".into(),
+        });
+    }
+    if model.elements > MAX_STATIC_ELEMENTS {
+        return Err(ModelError::Parameter {
+            name: "model.elements",
+            value: model.elements as f64,
+            allowed: format!(
+                "≤ {MAX_STATIC_ELEMENTS} for the spatial FE cables (their statics is dense so \
+                 far)"
+            ),
+        });
+    }
+    let mut pose = Vector3::zeros();
+    for &(axis, value) in rule.pinned() {
+        pose[axis] = value;
+    }
+    let base = rule.tensions(&[]);
+    let w = model.robot().structure_matrix(&pose);
+    let gram_inv = w.gram_inverse().ok_or_else(|| ModelError::State {
+        t: 0.0,
+        why: format!("the cables do not span space at {:?} m", pose.as_slice()),
+    })?;
+    let y = straight_guess(model, &pose, &base)?;
+    let np = model.positions_len();
+    let effector: Vec<usize> = (0..3).map(|a| model.effector_index(a)).collect();
+    let map: Vec<usize> = (0..np).filter(|i| !effector.contains(i)).collect();
+    let mut u: Vec<f64> = map.iter().map(|&i| y[i]).collect();
+    u.extend([0.0; 3]);
+    let mut problem = Problem {
+        model,
+        pose,
+        base,
+        w,
+        gram_inv,
+        y,
+        forces: vec![0.0; np],
+        map,
+    };
+    let report = newton::solve(&mut problem, &mut u, NewtonOptions::default())?;
+    problem.load(&u);
+    let tensions = problem.tensions(&u[problem.map.len()..]);
+    Ok(Equilibrium {
+        state: problem.y,
+        parameters: Vec::new(),
+        tensions,
+        iterations: report.iterations,
+        residual: report.residual,
+    })
+}
+
+/// Nodes on the chords, each span's and stored element's strain that of its tension.
+fn straight_guess(
+    model: &FeSpatial,
+    pose: &Vector3<f64>,
+    tensions: &Tensions,
+) -> Result<Vec<f64>, ModelError> {
+    let (n, np) = (model.elements, model.positions_len());
+    let mut y = vec![0.0; 2 * np];
+    for a in 0..3 {
+        y[model.effector_index(a)] = pose[a];
+    }
+    for cable in 0..model.robot().cables() {
+        let a = model.pulley(cable);
+        for k in 1..n {
+            let p = a + (pose - a) * (k as f64 / n as f64);
+            for axis in 0..3 {
+                y[model.node_index(cable, k, axis)] = p[axis];
+            }
+        }
+        let stretch = 1.0 + tensions[cable].max(0.0) / model.material.ea;
+        let l = (pose - a).norm() / stretch;
+        if l >= model.modelled_length {
+            return Err(ModelError::Parameter {
+                name: "cable.modelled_length",
+                value: model.modelled_length,
+                allowed: format!(
+                    "> {l} m, cable {}'s free unstrained length at {:?} m",
+                    cable + 1,
+                    pose.as_slice()
+                ),
+            });
+        }
+        let li = model.l_index(cable);
+        y[li] = l;
+        y[li + 1] = (model.modelled_length - l) * stretch;
+    }
+    Ok(y)
+}

@@ -1,0 +1,327 @@
+//! The variable-length FE cables in space (`cdpr_fe::spatial::FeSpatial`), checked against what
+//! they did not produce:
+//! - two cables in the x–z plane are the planar FE model (MODELS.md §5, itself checked against
+//!   FE.10's numbers): the same accelerations at any state, none across the plane;
+//! - at rest each cable lies in the vertical plane through its pulley and the effector (any
+//!   azimuth), on Irvine's elastic catenary at second order in 1/N;
+//! - the Hangprinter move: the energy balance with the reels' work (FE.7), the rest tensions of
+//!   the lumped lines to within the lines' weight, and the elastic cables' path as μ → 0;
+//! - what it does not run yet is refused by name.
+
+use cdpr_bench::core::model::{CableModel, PoseRule, SplitRule};
+use cdpr_bench::core::robot::Vector;
+use cdpr_bench::core::runner::Observer;
+use cdpr_bench::core::scenario::Scenario;
+use cdpr_bench::fe::spatial::FeSpatial;
+use cdpr_bench::fe::{Fe, Params};
+use cdpr_verify::irvine::Catenary;
+use nalgebra::Vector3;
+use proptest::prelude::*;
+
+/// The paper's robot spelled as a spatial one: anchors (0, 0, 0) and (d, 0, 0).
+fn paper_in_space() -> Scenario {
+    let mut s = Scenario::paper();
+    let d = s.robot.anchor_distance;
+    s.robot.anchors = Some(vec![vec![0.0, 0.0, 0.0], vec![d, 0.0, 0.0]]);
+    s
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// At any state near the paper's rest (x ∈ [0.5, 0.7] m, nodes moved by up to 5 mm and
+    /// moving at up to 0.5 m/s, l and ρ rates up to 0.5 m/s), N = 1 … 12, both mass variants:
+    /// the spatial model's accelerations are the planar model's to 1e-9 of the largest (the two
+    /// solve the same M q'' = F by different eliminations), and exactly 0 across the plane.
+    #[test]
+    fn two_cables_in_the_xz_plane_are_the_planar_fe(
+        x in 0.5f64..0.7, elements in 1usize..12, lumped in any::<bool>(),
+        seed in 0u64..1000, t1 in 80.0f64..120.0, t2 in 80.0f64..120.0,
+    ) {
+        let params = Params {
+            elements,
+            mass: if lumped { cdpr_bench::fe::FeMass::Lumped } else { cdpr_bench::fe::FeMass::Consistent },
+            ..Params::default()
+        };
+        let mut planar = Fe::new(&Scenario::paper(), params).unwrap();
+        let mut spatial = FeSpatial::from_scenario(&paper_in_space(), params).unwrap();
+        let rest = planar.equilibrium(&SplitRule::new(x, 200.0)).unwrap().state;
+        let mut state = seed as f64 * 0.618;
+        let mut jiggle = |scale: f64| {
+            state = (state * 9301.0 + 49297.0) % 233280.0;
+            scale * (state / 116640.0 - 1.0)
+        };
+        let (np2, np3, n) = (planar.positions_len(), spatial.positions_len(), elements);
+        let mut y2 = rest.clone();
+        for v in &mut y2[..np2 - 4] {
+            *v += jiggle(5e-3);
+        }
+        for v in &mut y2[np2..] {
+            *v = jiggle(0.5);
+        }
+        // The planar state in the spatial layout, y = 0.
+        let mut y3 = vec![0.0; 2 * np3];
+        let mut pairs = Vec::new();
+        for cable in 0..2 {
+            for k in 1..=n {
+                let j = planar.chain_index(cable, k).unwrap();
+                for (axis2, axis3) in [(0, 0), (1, 2)] {
+                    let from = planar.node_coordinate(j, axis2);
+                    let to = if k == n {
+                        spatial.effector_index(axis3)
+                    } else {
+                        spatial.node_index(cable, k, axis3)
+                    };
+                    pairs.push((from, to));
+                }
+            }
+            pairs.push((planar.l_index(cable), spatial.l_index(cable)));
+            pairs.push((planar.rho_index(cable).unwrap(), spatial.l_index(cable) + 1));
+        }
+        for &(from, to) in &pairs {
+            y3[to] = y2[from];
+            y3[np3 + to] = y2[np2 + from];
+        }
+        let (mut a2, mut a3) = (vec![0.0; np2], vec![0.0; np3]);
+        prop_assert!(planar.accelerations(&y2, [t1, t2], &mut a2));
+        prop_assert!(spatial.accelerations(&y3, &[t1, t2], &mut a3));
+        let scale = a2.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for &(from, to) in &pairs {
+            prop_assert!(
+                (a2[from] - a3[to]).abs() <= 1e-9 * scale,
+                "q[{from}]'' = {} planar, {} spatial (scale {scale:e})", a2[from], a3[to]
+            );
+        }
+        for cable in 0..2 {
+            for k in 1..n {
+                prop_assert_eq!(a3[spatial.node_index(cable, k, 1)], 0.0);
+            }
+        }
+        prop_assert_eq!(a3[spatial.effector_index(1)], 0.0);
+        // The same energy, term by term, to round-off.
+        let (e2, e3) = (planar.energy(&y2), spatial.energy(&y3));
+        prop_assert!((e2.total() - e3.total()).abs() <= 1e-12 * e2.total().abs().max(1.0));
+    }
+}
+
+/// The Hangprinter example on FE cables of `elements` elements, line density `density`
+/// [kg/m³] (the example's 970).
+fn hangprinter(elements: usize, density: f64) -> Scenario {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples/robots/hangprinter-lumped.toml");
+    let text = std::fs::read_to_string(path)
+        .unwrap()
+        .replace("kind = \"lumped\"", "kind = \"fe\"")
+        .replace("elements = 20", &format!("elements = {elements}"))
+        .replace("density = 970.0", &format!("density = {density}"));
+    Scenario::from_toml_str(&text).unwrap()
+}
+
+/// The rest at `p` under the QP's tensions there, N elements, line density `density`.
+fn rest(elements: usize, density: f64, p: [f64; 3]) -> (FeSpatial, Vec<f64>) {
+    let s = hangprinter(elements, density);
+    let config = cdpr_bench::ModelConfig::from_scenario(&s).unwrap();
+    let mut model = FeSpatial::from_scenario(&s, config.fe().unwrap()).unwrap();
+    let p = Vector::<3>::from(p);
+    let w = model.robot().structure_matrix(&p);
+    let lift = Vector::<3>::new(0.0, 0.0, model.robot().effector_mass * 9.81);
+    let limits = cdpr_bench::core::robot::distribution::TensionBox {
+        t_min: 10.0,
+        t_max: 70.0,
+    };
+    let d = cdpr_bench::core::robot::distribution::distribute(
+        cdpr_bench::core::robot::distribution::DistributionMethod::Qp,
+        &w,
+        &lift,
+        limits,
+    )
+    .unwrap();
+    let eq = model.equilibrium(&PoseRule::new(&p, d.tensions)).unwrap();
+    (model, eq.state)
+}
+
+/// The largest distance of a cable's nodes from Irvine's catenary with the same free unstrained
+/// length between the same ends [m].
+fn irvine_gap(model: &FeSpatial, y: &[f64]) -> f64 {
+    let n = model.elements;
+    let p = model.effector(y).position;
+    let w = model.material.mu * model.material.gravity;
+    let mut worst = 0.0f64;
+    for cable in 0..model.robot().cables() {
+        let a = model.pulley(cable);
+        let d = p - a;
+        let horizontal = Vector3::new(d.x, d.y, 0.0);
+        let l = model.free_length(y, cable);
+        if horizontal.norm() < 1e-9 {
+            continue; // a plumb line: no catenary
+        }
+        let unit = horizontal.normalize();
+        let c = Catenary::through([horizontal.norm(), d.z], l, w, model.material.ea).unwrap();
+        for k in 1..n {
+            let [s, z] = c.position(l * k as f64 / n as f64);
+            let on = a + unit * s + Vector3::z() * z;
+            worst = worst.max((model.node(y, cable, k).0 - on).norm());
+        }
+    }
+    worst
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(8))]
+
+    /// Anywhere in the Hangprinter's volume, every node of every cable at rest lies in the
+    /// vertical plane through its pulley and the effector (1e-12 m: nothing pushes across it).
+    #[test]
+    fn each_cable_rests_in_its_vertical_plane(
+        x in -0.3f64..0.3, y in -0.3f64..0.3, z in 0.0f64..0.6,
+    ) {
+        let (model, state) = rest(6, 970.0, [x, y, z]);
+        let p = model.effector(&state).position;
+        for cable in 0..4 {
+            let a = model.pulley(cable);
+            let across = Vector3::z().cross(&(p - a));
+            if across.norm() < 1e-9 {
+                continue;
+            }
+            let normal = across.normalize();
+            for k in 1..model.elements {
+                let off = (model.node(&state, cable, k).0 - a).dot(&normal);
+                prop_assert!(off.abs() <= 1e-12, "cable {cable} node {k}: {off:e} m");
+            }
+        }
+    }
+}
+
+/// A heavy line (ρ = 2e4 kg/m³, 20 times the example's sag: ~4 mm on 1.5 m at 13 N) at two
+/// poses: the nodes approach Irvine's catenary at second order — the gap falls by 0.2–0.3 per
+/// doubling of N (0.25 for a second-order method; measured 0.2502–0.2508) — and lie within
+/// 4 µm (1e-3 of the sag) of it at N = 16.
+#[test]
+fn each_span_tends_to_irvines_catenary_at_second_order() {
+    for p in [[0.1, 0.05, 0.02], [-0.2, 0.2, 0.4]] {
+        let gaps: Vec<f64> = [4, 8, 16]
+            .iter()
+            .map(|&n| {
+                let (model, state) = rest(n, 2e4, p);
+                irvine_gap(&model, &state)
+            })
+            .collect();
+        for k in 1..gaps.len() {
+            let ratio = gaps[k] / gaps[k - 1];
+            assert!(
+                (0.2..=0.3).contains(&ratio),
+                "gaps {gaps:?} at {p:?}: ratio {ratio}"
+            );
+        }
+        assert!(gaps[2] < 4e-6, "{gaps:?}");
+    }
+}
+
+/// The Hangprinter move (computed-torque, QP, 0.4 s) on FE cables of 10 elements.
+fn run(s: &Scenario) -> cdpr_bench::SpatialRun {
+    let mut quiet = |_: f64| {};
+    cdpr_bench::simulate_spatial(s, &mut Observer::progress(&mut quiet)).unwrap()
+}
+
+fn short(mut s: Scenario) -> Scenario {
+    s.simulation.t_final = 0.4;
+    s.validate().unwrap();
+    s
+}
+
+/// The move's energy balance with the reels' work W = ∫ Σ T_i ρ_i' dt (FE.7) closes to 1e-6 J
+/// (DOPRI5 at the default tolerances; measured 1e-8 J over the 1.2 s move) on ~3 J of work; the
+/// rest at the start carries the same tensions as the lumped lines' to within a third of one
+/// line's weight (both models carry the lines' weight, each to its discretisation's order).
+#[test]
+fn the_move_balances_energy_and_rests_as_the_lumped_lines() {
+    let fe = run(&short(hangprinter(10, 970.0)));
+    let m = &fe.metrics;
+    assert!(
+        m.energy_residual_max < 1e-6,
+        "{:e} J",
+        m.energy_residual_max
+    );
+    let mut lumped_scenario = short(hangprinter(10, 970.0));
+    lumped_scenario =
+        cdpr_bench::with_model_kind(&lumped_scenario, cdpr_bench::ModelKind::Lumped).unwrap();
+    let lumped = run(&lumped_scenario);
+    let line_weight = 970.0 * 9.503e-7 * 2.3 * 9.81;
+    for (a, b) in m.rest_tensions.iter().zip(&lumped.metrics.rest_tensions) {
+        assert!(
+            (a - b).abs() < line_weight / 3.0,
+            "rest tensions {:?} against the lumped {:?}",
+            m.rest_tensions,
+            lumped.metrics.rest_tensions
+        );
+    }
+}
+
+/// As the lines' mass vanishes the FE robot's move tends to the massless elastic cables':
+/// the largest distance between the two effector paths halves with the density (ratio within
+/// [0.4, 0.6]: the lines' inertia and weight act at first order in μ).
+#[test]
+fn the_path_tends_to_the_elastic_cables_as_mu_goes_to_zero() {
+    let elastic = run(&short(
+        cdpr_bench::with_model_kind(&hangprinter(10, 970.0), cdpr_bench::ModelKind::Elastic)
+            .unwrap(),
+    ));
+    let path = |r: &cdpr_bench::SpatialRun| {
+        use cdpr_bench::core::channel::Channel;
+        let s = &r.run.series;
+        let c = |ch| s.column(ch).unwrap();
+        (c(Channel::X), c(Channel::Y), c(Channel::Z))
+    };
+    let (ex, ey, ez) = path(&elastic);
+    let gaps: Vec<f64> = [970.0, 485.0, 242.5]
+        .iter()
+        .map(|&rho| {
+            let (x, y, z) = path(&run(&short(hangprinter(10, rho))));
+            (0..x.len())
+                .map(|i| {
+                    ((x[i] - ex[i]).powi(2) + (y[i] - ey[i]).powi(2) + (z[i] - ez[i]).powi(2))
+                        .sqrt()
+                })
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    for k in 1..gaps.len() {
+        let ratio = gaps[k] / gaps[k - 1];
+        assert!((0.4..=0.6).contains(&ratio), "gaps {gaps:?}: ratio {ratio}");
+    }
+}
+
+/// What the spatial FE cables do not run yet is refused by name: the length controller, the
+/// implicit path and the rigid stored cable before any work, a mesh beyond the dense statics
+/// at the start.
+#[test]
+fn what_is_not_built_is_refused_by_name() {
+    use cdpr_bench::core::scenario::{ControllerKind, IntegratorKind};
+    let refused = |s: Scenario, key: &str| {
+        let e = cdpr_bench::prepare_spatial(&s)
+            .err()
+            .map(|e| e.to_string())
+            .or_else(|| {
+                let mut quiet = |_: f64| {};
+                cdpr_bench::simulate_spatial(&s, &mut Observer::progress(&mut quiet))
+                    .err()
+                    .map(|e| e.to_string())
+            })
+            .unwrap_or_else(|| panic!("{key}: accepted"));
+        assert!(e.contains(key), "{key}: {e}");
+    };
+    let mut s = hangprinter(10, 970.0);
+    s.controller.kind = ControllerKind::Length;
+    refused(s, "controller.kind");
+    let mut s = hangprinter(10, 970.0);
+    s.simulation.integrator = IntegratorKind::Implicit;
+    refused(s, "simulation.integrator");
+    refused(short(hangprinter(61, 970.0)), "model.elements");
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples/robots/hangprinter-lumped.toml");
+    let rigid = std::fs::read_to_string(path)
+        .unwrap()
+        .replace("kind = \"lumped\"", "kind = \"fe\"\nfe_stored = \"rigid\"")
+        .replace("elements = 20", "elements = 10");
+    refused(Scenario::from_toml_str(&rigid).unwrap(), "model.fe_stored");
+}
