@@ -245,6 +245,9 @@ fn ratio_range(pairs: impl Iterator<Item = (Option<f64>, f64)>) -> String {
     format!("{lo:.4} … {hi:.4}")
 }
 
+/// Elements per span of the leaderboard's FE cables (the paper's discretisation).
+pub const FE_ELEMENTS: usize = 10;
+
 /// One cable model's rows of the leaderboard.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ModelMoves {
@@ -253,14 +256,24 @@ pub struct ModelMoves {
 }
 
 /// `scenario`'s move under every controller (the `length` controller with each flex
-/// compensation) with its distribution, on the elastic cables and on the lumped lines of its
-/// `[model]` (a scenario on elastic cables: lumped lines of 20 springs).
+/// compensation) with its distribution, on the elastic cables, on the lumped lines of its
+/// `[model]` (a scenario on elastic cables: lumped lines of 20 springs) and on FE cables of
+/// [`FE_ELEMENTS`] elements (the tension controllers: FE reels driven by length are not built
+/// yet).
 pub fn leaderboard(scenario: &Scenario) -> Result<Vec<ModelMoves>> {
     let method = [scenario.controller.distribution];
     let mut out = Vec::new();
-    for kind in [ModelKind::Elastic, ModelKind::Lumped] {
+    for kind in ModelKind::ALL {
         let s = if cdpr_bench::ModelConfig::from_scenario(scenario)?.kind == kind {
             scenario.clone()
+        } else if kind == ModelKind::Fe {
+            let mut config = cdpr_bench::ModelConfig::from_scenario(scenario)?;
+            config.kind = kind;
+            config.elements = Some(FE_ELEMENTS as i64);
+            let mut s = scenario.clone();
+            s.model = config.section();
+            cdpr_bench::validate(&s)?;
+            s
         } else {
             cdpr_bench::with_model_kind(scenario, kind)?
         };

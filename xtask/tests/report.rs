@@ -146,7 +146,8 @@ fn report_writes_every_figure_table_and_file() {
     let spatial: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("spatial.json")).unwrap()).unwrap();
     assert_eq!(spatial["printers"].as_array().unwrap().len(), 2);
-    assert_eq!(spatial["leaderboard"].as_array().unwrap().len(), 2);
+    // Elastic, lumped and FE cables.
+    assert_eq!(spatial["leaderboard"].as_array().unwrap().len(), 3);
     let gif = std::fs::File::open(out.join("spatial_hangprinter_move.gif")).unwrap();
     let frames = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(gif))
         .and_then(|d| image::AnimationDecoder::into_frames(d).collect_frames())
