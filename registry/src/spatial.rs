@@ -127,11 +127,10 @@ fn check_lumped(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
     Ok(())
 }
 
-/// What the spatial FE cables run so far: three or more cables on reels pulled by tension, on
-/// DOPRI5 (the second-order form of the star, reels driven by length and the rigid stored cable
-/// are planar only).
+/// What the spatial FE cables run so far: three or more cables on reels pulled by tension (reels
+/// driven by length and the rigid stored cable are planar only).
 fn check_fe(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
-    use cdpr_core::scenario::{ControllerKind, IntegratorKind};
+    use cdpr_core::scenario::ControllerKind;
     let refuse = |key: &'static str, value: String, allowed: &str| -> Result<(), Error> {
         Err(out_of_range(key, value, allowed.to_owned()).into())
     };
@@ -149,14 +148,6 @@ fn check_fe(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
             "a tension controller (pid, pid-xz, computed-torque, lqr): reels driven by length \
              on FE cables in space (MODELS.md FE.11.10's prescribed length) are not built yet; \
              the lumped lines follow lengths",
-        );
-    }
-    if scenario.simulation.integrator == IntegratorKind::Implicit {
-        return refuse(
-            "simulation.integrator",
-            "\"implicit\" with model.kind = \"fe\" and robot.anchors".into(),
-            "\"dopri5\": the spatial FE cables have no second-order form for the implicit path \
-             yet",
         );
     }
     Ok(())

@@ -6,9 +6,10 @@
 //!
 //! Generalised coordinates: per cable i its free nodes k = 1 … N − 1 (x, y, z each, cable-major),
 //! then P, then per cable (l_i, ρ_i); n = 3m(N − 1) + 3 + 2m, the state (q, q'). M q'' = F is
-//! solved on the star of arms in O(N m) ([`star`]). The stored cable is elastic (FE.1.3's
-//! reference variant); the rigid variant and the implicit path are planar only so far.
+//! solved on the star of arms in O(N m) ([`star`]); the implicit path's form is [`implicit`].
+//! The stored cable is elastic (FE.1.3's reference variant); the rigid variant is planar only.
 
+mod implicit;
 mod star;
 mod statics;
 
@@ -41,6 +42,8 @@ pub struct FeSpatial {
     /// Accelerations of the free nodes (cable-major) and of (l_i, ρ_i), per solve.
     node_accelerations: Vec<Vector3<f64>>,
     border_accelerations: Vec<[f64; 2]>,
+    /// The implicit path's coloured differences (built at the first iteration matrix).
+    differences: Option<cdpr_numerics::differences::ColouredDifferences>,
 }
 
 impl FeSpatial {
@@ -118,6 +121,7 @@ impl FeSpatial {
             system: StarSystem::new(m, n - 1),
             node_accelerations: vec![Vector3::zeros(); m * (n - 1)],
             border_accelerations: vec![[0.0; 2]; m],
+            differences: None,
         }
     }
 
@@ -386,6 +390,14 @@ impl CableModel<3> for FeSpatial {
             d += element::dissipation(&self.material, &s, self.axial_damping);
         }
         d
+    }
+
+    fn second_order(&self) -> Option<&dyn cdpr_core::second_order::SecondOrderForm> {
+        Some(self)
+    }
+
+    fn second_order_mut(&mut self) -> Option<&mut dyn cdpr_core::second_order::SecondOrderForm> {
+        Some(self)
     }
 
     /// The pulley, the free nodes and the effector.

@@ -1,0 +1,128 @@
+//! The spatial FE robot's second-order form R = M(q) q'' − F(q, q', T) for the implicit path
+//! (MODELS.md FE.9.3): R from the star's assembly ([`super::star::StarSystem::residual`]), the
+//! iteration matrix by coloured central differences of R over the star's pattern
+//! ([`ColouredDifferences`]), each position step kept within a quarter of the stretch of the
+//! elements it moves so that no probe reaches the tension-only kink.
+
+use super::FeSpatial;
+use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
+use cdpr_numerics::differences::ColouredDifferences;
+
+impl FeSpatial {
+    /// Every coordinate element e of `cable` moves: its end nodes' (those that are free or
+    /// the effector) and l_i.
+    fn element_dofs(&self, cable: usize, e: usize) -> Vec<usize> {
+        let mut dofs = Vec::with_capacity(7);
+        for k in [e - 1, e] {
+            if k == self.elements {
+                dofs.extend((0..3).map(|a| self.effector_index(a)));
+            } else if k > 0 {
+                dofs.extend((0..3).map(|a| self.node_index(cable, k, a)));
+            }
+        }
+        dofs.push(self.l_index(cable));
+        dofs
+    }
+}
+
+impl SecondOrderForm for FeSpatial {
+    fn dofs(&self) -> usize {
+        self.positions_len()
+    }
+
+    fn effector_coordinate(&self, k: usize) -> usize {
+        self.effector_index(k)
+    }
+
+    /// The ρ_i rows, where the reels pull.
+    fn tension_rows(&self) -> Vec<usize> {
+        (0..self.robot.cables())
+            .map(|c| self.l_index(c) + 1)
+            .collect()
+    }
+
+    /// Per element every pair of its coordinates; per stored element (l_i, ρ_i).
+    fn iteration_pattern(&self) -> Vec<(usize, usize)> {
+        let mut pattern = Vec::new();
+        for cable in 0..self.robot.cables() {
+            for e in 1..=self.elements {
+                let dofs = self.element_dofs(cable, e);
+                for &r in &dofs {
+                    pattern.extend(dofs.iter().map(|&c| (r, c)));
+                }
+            }
+            let (l, rho) = (self.l_index(cable), self.l_index(cable) + 1);
+            pattern.extend([(l, l), (l, rho), (rho, l), (rho, rho)]);
+        }
+        pattern.sort_unstable();
+        pattern.dedup();
+        pattern
+    }
+
+    /// The l_i (every node of their span depends on them) and the effector (every span ends
+    /// there): the star's hub, as the explicit solve's globals.
+    fn coupled_unknowns(&self) -> Vec<usize> {
+        let mut hub: Vec<usize> = (0..3).map(|a| self.effector_index(a)).collect();
+        hub.extend((0..self.robot.cables()).map(|c| self.l_index(c)));
+        hub
+    }
+
+    /// The stiffest element, EA/h with h = min l_i / N.
+    fn residual_round_off(&self, state: &[f64]) -> f64 {
+        let shortest = (0..self.robot.cables())
+            .map(|c| state[self.l_index(c)] / self.elements as f64)
+            .fold(f64::INFINITY, f64::min);
+        spring_round_off(self.material.ea / shortest, &state[..self.positions_len()])
+    }
+
+    /// Per coordinate, a quarter of the smallest |stretch| ||Δ| − h| of the elements it moves
+    /// (ρ_i: the stored element's).
+    fn smooth_reach(&self, state: &[f64], out: &mut [f64]) {
+        out.fill(f64::INFINITY);
+        for cable in 0..self.robot.cables() {
+            for e in 1..=self.elements {
+                let s = self.free_element(state, cable, e);
+                let limit = 0.25 * ((s.rb - s.ra).norm() - s.h).abs();
+                for d in self.element_dofs(cable, e) {
+                    out[d] = out[d].min(limit);
+                }
+            }
+            let s = self.stored_element(state, cable);
+            let limit = 0.25 * ((s.rb - s.ra).norm() - s.h).abs();
+            let (l, rho) = (self.l_index(cable), self.l_index(cable) + 1);
+            out[l] = out[l].min(limit);
+            out[rho] = out[rho].min(limit);
+        }
+    }
+
+    fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: &[f64], r: &mut [f64]) {
+        self.assemble(state, tensions);
+        self.system.residual(qdd, r);
+    }
+
+    fn iteration_matrix(
+        &mut self,
+        state: &[f64],
+        qdd: &[f64],
+        tensions: &[f64],
+        c_v: f64,
+        c_q: f64,
+        values: &mut [f64],
+    ) -> MatrixCost {
+        let mut differences = match self.differences.take() {
+            Some(d) => d,
+            None => ColouredDifferences::new(self.positions_len(), &self.iteration_pattern()),
+        };
+        self.smooth_reach(state, differences.step_limits_mut());
+        let evals = differences.fill(
+            &mut |s, a, r| SecondOrderForm::residual(self, s, a, tensions, r),
+            state,
+            qdd,
+            c_v,
+            c_q,
+            values,
+        );
+        self.differences = Some(differences);
+        MatrixCost::differences(evals)
+    }
+}
