@@ -74,14 +74,7 @@ pub fn over_box(
             held_tensions: hangs.iter().map(|h| h.straddle_tension).collect(),
         }))
     })?;
-    let mut points = Vec::new();
-    let mut infeasible = 0;
-    for row in rows {
-        match row? {
-            Some(point) => points.push(point),
-            None => infeasible += 1,
-        }
-    }
+    let (points, infeasible) = feasible(rows)?;
     let max = points.iter().map(|p| p.error).fold(0.0, f64::max);
     let rms =
         (points.iter().map(|p| p.error * p.error).sum::<f64>() / points.len().max(1) as f64).sqrt();
@@ -92,6 +85,20 @@ pub fn over_box(
         max,
         rms,
     })
+}
+
+/// A grid study's rows split into the targets' results and the count of targets outside the
+/// wrench-feasible workspace (None), or its first error.
+pub fn feasible<T>(rows: Vec<Result<Option<T>>>) -> Result<(Vec<T>, usize)> {
+    let mut points = Vec::new();
+    let mut infeasible = 0;
+    for row in rows {
+        match row? {
+            Some(point) => points.push(point),
+            None => infeasible += 1,
+        }
+    }
+    Ok((points, infeasible))
 }
 
 /// The `per_axis`³ targets spanning the box `low`–`high` [m], x fastest, then y, then z (one

@@ -133,14 +133,7 @@ pub fn mode_map(
             share_below,
         }))
     })?;
-    let mut points = Vec::new();
-    let mut infeasible = 0;
-    for row in rows {
-        match row? {
-            Some(point) => points.push(point),
-            None => infeasible += 1,
-        }
-    }
+    let (points, infeasible) = crate::flex_error::feasible(rows)?;
     Ok(ModeMap {
         elements,
         low,

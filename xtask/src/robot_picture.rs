@@ -4,22 +4,11 @@
 //! or a run's frames as an animated GIF ([`write_gif`]).
 
 use crate::figures::{Drawing, register_fonts};
+use crate::spatial_figures::CABLE_COLORS;
 use anyhow::{Context, Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
-
-/// Cable colours, cable 1 first (as the spatial run's figures).
-const CABLE_COLORS: [RGBColor; 8] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(148, 103, 189),
-    RGBColor(255, 127, 14),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(127, 127, 127),
-];
 
 /// One picture of the robot.
 pub struct RobotPicture {

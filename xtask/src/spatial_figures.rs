@@ -16,7 +16,7 @@ use std::path::Path;
 const PATH_POINTS: usize = 4000;
 
 /// Cable colours, cable 1 first.
-const CABLE_COLORS: [RGBColor; 8] = [
+pub(crate) const CABLE_COLORS: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),

@@ -144,13 +144,7 @@ impl LumpedSpatial {
             value: f64::NAN,
             allowed: "the anchors of a spatial robot".into(),
         })?;
-        let reels: Vec<Vector3<f64>> = match &scenario.robot.reel_directions {
-            Some(given) => given
-                .iter()
-                .map(|r| Vector3::from_iterator(r.iter().copied()))
-                .collect(),
-            None => default_reel_directions(robot.anchors()),
-        };
+        let reels = cdpr_core::robot::reels::scenario_reel_directions(scenario, &robot)?;
         let c = &scenario.cable;
         let cable = CableProperties {
             elements,
