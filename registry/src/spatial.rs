@@ -127,10 +127,10 @@ fn check_lumped(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
     Ok(())
 }
 
-/// What the spatial FE cables run so far: three or more cables on reels pulled by tension (reels
-/// driven by length and the rigid stored cable are planar only).
+/// What the spatial FE cables run: three or more cables, on reels pulled by tension, or driven
+/// by length (Du's prescribed free lengths) on DOPRI5.
 fn check_fe(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
-    use cdpr_core::scenario::ControllerKind;
+    use cdpr_core::scenario::{ControllerKind, IntegratorKind};
     let refuse = |key: &'static str, value: String, allowed: &str| -> Result<(), Error> {
         Err(out_of_range(key, value, allowed.to_owned()).into())
     };
@@ -141,13 +141,14 @@ fn check_fe(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
             "3 to 8 anchors for the spatial FE cables (two cables in space run elastic)",
         );
     }
-    if scenario.controller.kind == ControllerKind::Length {
+    if scenario.controller.kind == ControllerKind::Length
+        && scenario.simulation.integrator == IntegratorKind::Implicit
+    {
         return refuse(
-            "controller.kind",
-            "\"length\" with model.kind = \"fe\" and robot.anchors".into(),
-            "a tension controller (pid, pid-xz, computed-torque, lqr): reels driven by length \
-             on FE cables in space (MODELS.md FE.11.10's prescribed length) are not built yet; \
-             the lumped lines follow lengths",
+            "simulation.integrator",
+            "\"implicit\" with controller.kind = \"length\" and model.kind = \"fe\"".into(),
+            "\"dopri5\": reels driven by length on massive cables run on DOPRI5 (the reel's \
+             velocity loop is not in the second-order form)",
         );
     }
     Ok(())

@@ -64,10 +64,6 @@ pub fn table_with(scenario: &Scenario, methods: &[DistributionMethod]) -> Result
     let model = cdpr_bench::ModelConfig::from_scenario(scenario)?.kind;
     let massive = model != ModelKind::Elastic;
     for (name, kind, flex) in controllers() {
-        if model == ModelKind::Fe && kind == ControllerKind::Length {
-            // Reels driven by length on FE cables in space are not built yet (refused by name).
-            continue;
-        }
         for &method in methods {
             let mut s = scenario.clone();
             s.controller.kind = kind;

@@ -251,8 +251,7 @@ pub struct ModelMoves {
 /// `scenario`'s move under every controller (the `length` controller with each flex
 /// compensation) with its distribution, on the elastic cables, on the lumped lines of its
 /// `[model]` (a scenario on elastic cables: lumped lines of 20 springs) and on FE cables of
-/// [`FE_ELEMENTS`] elements (the tension controllers: FE reels driven by length are not built
-/// yet).
+/// [`FE_ELEMENTS`] elements.
 pub fn leaderboard(scenario: &Scenario) -> Result<Vec<ModelMoves>> {
     let method = [scenario.controller.distribution];
     let mut out = Vec::new();

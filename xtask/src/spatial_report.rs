@@ -88,7 +88,7 @@ pub fn run(out: &Path, per_axis: usize) -> Result<String> {
         "## What the lines' mass does to a printer\n\nBeyond the paper (`cargo xtask spatial`; \
          docs/spatial.md): the Hangprinter-like and CoGiRo-like robots on their massive lines \
          (lumped, MODELS.md §11) against massless elastic cables; the leaderboard adds the \
-         finite-element cables (N = 10, tension controllers).\n\n",
+         finite-element cables (N = 10).\n\n",
     );
     let mut maps = Vec::new();
     for p in &PRINTERS {
@@ -131,7 +131,8 @@ pub fn run(out: &Path, per_axis: usize) -> Result<String> {
         "### The Hangprinter move on every cable model\n\nThe move of `{}` (0.11 m in 0.2 s, \
          box [10, 70] N, {} distribution) under every controller; `length/…` is the \
          firmware's length control with each flex compensation (on the lumped lines the reels \
-         feed the commanded unstrained length; FE reels driven by length are not built yet).\n\n{}\n",
+         feed the commanded unstrained length, on FE cables they prescribe the free \
+         length).\n\n{}\n",
         PRINTERS[0].file,
         hang.controller.distribution.name(),
         spatial_printers::leaderboard_markdown(&board)

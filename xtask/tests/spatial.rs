@@ -230,8 +230,10 @@ fn spatial_runs_are_refused_before_any_file() {
         ("fast.toml", fast, "wrench-feasible workspace at t ="),
         (
             "fe.toml",
-            long(model("kind = \"fe\"")).replace("\"computed-torque\"", "\"length\""),
-            "controller.kind",
+            long(model("kind = \"fe\""))
+                .replace("\"computed-torque\"", "\"length\"")
+                .replace("[simulation]", "[simulation]\nintegrator = \"implicit\""),
+            "simulation.integrator",
         ),
         (
             "short.toml",

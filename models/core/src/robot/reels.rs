@@ -7,6 +7,11 @@ use super::Robot;
 use crate::model::ModelError;
 use nalgebra::Vector3;
 
+/// Time constant τ of a length-driven reel's velocity loop [s]: the massive models' reels follow
+/// the commanded l̇0 with the loop's correction (v_cmd − v)/τ added to the command's own
+/// derivative — far faster than the effector's modes, far slower than the lines' axial ones.
+pub const REEL_TIME_CONSTANT: f64 = 1e-4;
+
 /// The anchors' centroid [m], the workspace's middle for the reel directions.
 pub fn centroid(anchors: &[Vector3<f64>]) -> Vector3<f64> {
     anchors.iter().sum::<Vector3<f64>>() / anchors.len() as f64

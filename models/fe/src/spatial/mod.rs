@@ -44,6 +44,12 @@ pub struct FeSpatial {
     border_accelerations: Vec<[f64; 2]>,
     /// The implicit path's coloured differences (built at the first iteration matrix).
     differences: Option<cdpr_numerics::differences::ColouredDifferences>,
+    /// Reels driven by length (the scenario's `length` controller): the free lengths l_i are
+    /// prescribed (MODELS.md FE.5.6, Du's form), the stored cable is on the reel and not
+    /// modelled; `drive` holds the commanded (l̇0_i, l̈0_i) from the last
+    /// [`CableModel::drive_reels`].
+    length_driven: bool,
+    drive: Option<(PerCable, PerCable)>,
 }
 
 impl FeSpatial {
@@ -81,7 +87,7 @@ impl FeSpatial {
             });
         }
         let reels = cdpr_core::robot::reels::scenario_reel_directions(scenario, &robot)?;
-        Ok(Self::new(
+        let mut model = Self::new(
             robot,
             reels,
             params.mass,
@@ -93,7 +99,10 @@ impl FeSpatial {
                 gravity: scenario.robot.gravity,
             },
             cable.axial_damping,
-        ))
+        );
+        model.length_driven =
+            scenario.controller.kind == cdpr_core::scenario::ControllerKind::Length;
+        Ok(model)
     }
 
     fn new(
@@ -122,6 +131,8 @@ impl FeSpatial {
             node_accelerations: vec![Vector3::zeros(); m * (n - 1)],
             border_accelerations: vec![[0.0; 2]; m],
             differences: None,
+            length_driven: false,
+            drive: None,
         }
     }
 
@@ -214,9 +225,69 @@ impl FeSpatial {
         )
     }
 
-    /// Assembles M(q) and F(q, q', T) (FE.5.3) on the star.
+    /// Assembles M(q) and F(q, q', T) (FE.5.3) on the star; with the reels driven by length,
+    /// the l_i rows prescribe l_i'' ([`Self::prescribe_lengths`]).
     fn assemble(&mut self, y: &[f64], tensions: &[f64]) {
         let mut sys = std::mem::take(&mut self.system);
+        self.assemble_into(&mut sys, y, tensions, !self.length_driven);
+        if self.length_driven {
+            self.prescribe_lengths(&mut sys, y);
+        }
+        self.system = sys;
+    }
+
+    /// The commanded l_i'' [m/s²]: l̈0_i plus the velocity loop (l̇0_i − l_i')/τ
+    /// ([`cdpr_core::robot::reels::REEL_TIME_CONSTANT`]), as the lumped lines' reels.
+    fn commanded_l_acceleration(&self, y: &[f64], cable: usize) -> f64 {
+        let l_rate = y[self.positions_len() + self.l_index(cable)];
+        let (rate, acceleration) = self.drive.map_or((0.0, 0.0), |(r, a)| (r[cable], a[cable]));
+        acceleration + (rate - l_rate) / cdpr_core::robot::reels::REEL_TIME_CONSTANT
+    }
+
+    /// Du's form (MODELS.md FE.5.6): l_i'' is known, so its columns move to the right-hand side
+    /// and its row becomes l_i'' = the command; ρ_i (the reel side, not modelled) stays still.
+    fn prescribe_lengths(&self, sys: &mut StarSystem, y: &[f64]) {
+        let nn = self.elements - 1;
+        for cable in 0..self.robot.cables() {
+            let a = self.commanded_l_acceleration(y, cable);
+            for k in cable * nn..(cable + 1) * nn {
+                sys.force[k] -= sys.l_column[k] * a;
+                sys.l_column[k] = Vector3::zeros();
+            }
+            sys.effector_force -= sys.effector_l[cable] * a;
+            sys.effector_l[cable] = Vector3::zeros();
+            sys.border[cable] = [1.0, 0.0, 1.0, a, 0.0];
+        }
+    }
+
+    /// The force each driven reel needs to impose l_i, Q_l,i = (M q'' − F)_l of the span alone
+    /// (MODELS.md FE.7: d/dt(E_span + E_P) = Σ Q_l,i l_i'), at `y` [N].
+    fn prescribing_forces(&self, y: &[f64]) -> Vec<f64> {
+        let (m, nn) = (self.robot.cables(), self.elements - 1);
+        let mut sys = StarSystem::new(m, nn);
+        self.assemble_into(&mut sys, y, &vec![0.0; m], false);
+        let original = sys.clone();
+        self.prescribe_lengths(&mut sys, y);
+        let mut nodes = vec![Vector3::zeros(); m * nn];
+        let (mut effector, mut border) = (Vector3::zeros(), vec![[0.0; 2]; m]);
+        if !sys.solve(&mut nodes, &mut effector, &mut border) {
+            return vec![f64::NAN; m];
+        }
+        (0..m)
+            .map(|c| {
+                let [d_ll, _, _, f_l, _] = original.border[c];
+                let span: f64 = (c * nn..(c + 1) * nn)
+                    .map(|k| original.l_column[k].dot(&nodes[k]))
+                    .sum();
+                span + original.effector_l[c].dot(&effector) + d_ll * border[c][0] - f_l
+            })
+            .collect()
+    }
+
+    /// M(q) and F(q, q', T) (FE.5.3) into `sys`: the spans, the stored elements if `stored`
+    /// (not when the reels are driven by length: the stored cable is then on the reel) and the
+    /// effector.
+    fn assemble_into(&self, sys: &mut StarSystem, y: &[f64], tensions: &[f64], stored: bool) {
         sys.clear();
         let (n, nn) = (self.elements, self.elements - 1);
         let mat = self.material;
@@ -252,6 +323,9 @@ impl FeSpatial {
                 border[0] += t.m_ll;
                 border[3] += t.fl;
             }
+            if !stored {
+                continue;
+            }
             // Row ρ: the kernel's R-node terms along r (R = A + ρ r), plus the commanded tension
             // pulling R away from the pulley (FE.5.3).
             let s = self.stored_element(y, cable);
@@ -265,7 +339,6 @@ impl FeSpatial {
         }
         sys.effector_mass += self.robot.effector_mass;
         sys.effector_force.z -= self.robot.effector_mass * mat.gravity;
-        self.system = sys;
     }
 
     /// q'' = M⁻¹F for state `y` and `tensions` into `qdd` (length n) [m/s²]; false if M is not
@@ -292,8 +365,12 @@ impl FeSpatial {
     }
 
     /// The forces F(q, 0, T) at rest [N], in q's order (the statics' residual).
+    /// At rest the reels hold the cables' tensions whatever drives them later, so the stored
+    /// elements take part and no length is prescribed.
     fn rest_forces(&mut self, y: &[f64], tensions: &[f64], out: &mut [f64]) {
-        self.assemble(y, tensions);
+        let mut sys = std::mem::take(&mut self.system);
+        self.assemble_into(&mut sys, y, tensions, true);
+        self.system = sys;
         let s = &self.system;
         for (j, f) in s.force.iter().enumerate() {
             out[3 * j..3 * j + 3].copy_from_slice(f.as_slice());
@@ -346,10 +423,40 @@ impl CableModel<3> for FeSpatial {
         Effector { position, velocity }
     }
 
-    /// dE/dt = Σ T_i ρ_i' (FE.7): the reel end moving away from the pulley takes cable in.
+    /// dE/dt = Σ T_i ρ_i' (FE.7): the reel end moving away from the pulley takes cable in;
+    /// driven by length, the line the reel takes in, −l_i'.
     fn reel_speeds(&self, y: &[f64]) -> PerCable {
         let np = self.positions_len();
-        PerCable::from_fn(self.robot.cables(), |c| y[np + self.l_index(c) + 1])
+        PerCable::from_fn(self.robot.cables(), |c| {
+            if self.length_driven {
+                -y[np + self.l_index(c)]
+            } else {
+                y[np + self.l_index(c) + 1]
+            }
+        })
+    }
+
+    /// The free lengths can be prescribed (Du's form, MODELS.md FE.5.6).
+    fn reels_follow_lengths(&self) -> bool {
+        true
+    }
+
+    fn drive_reels(&mut self, rates: &PerCable, accelerations: &PerCable) {
+        self.drive = Some((*rates, *accelerations));
+    }
+
+    /// Σ T_i ρ_i' under tension; driven by length, Σ Q_l,i l_i' with Q_l,i the force that
+    /// imposes l_i (FE.7's identity for prescribed lengths).
+    fn reel_power(&self, y: &[f64], tensions: &PerCable, reel_speeds: &PerCable) -> f64 {
+        if !self.length_driven {
+            return tensions.dot(reel_speeds);
+        }
+        let np = self.positions_len();
+        self.prescribing_forces(y)
+            .iter()
+            .enumerate()
+            .map(|(c, q)| q * y[np + self.l_index(c)])
+            .sum()
     }
 
     fn energy(&self, y: &[f64]) -> Energy {
@@ -362,6 +469,9 @@ impl CableModel<3> for FeSpatial {
                 e.kinetic += k;
                 e.elastic += u;
                 e.gravity += g;
+            }
+            if self.length_driven {
+                continue; // the stored cable is on the reel
             }
             let s = self.stored_element(y, cable);
             let (k, u, g) = element::energies(mat, &self.stored_coefficients, &s);
@@ -386,8 +496,10 @@ impl CableModel<3> for FeSpatial {
                 let s = self.free_element(y, cable, el);
                 d += element::dissipation(&self.material, &s, self.axial_damping);
             }
-            let s = self.stored_element(y, cable);
-            d += element::dissipation(&self.material, &s, self.axial_damping);
+            if !self.length_driven {
+                let s = self.stored_element(y, cable);
+                d += element::dissipation(&self.material, &s, self.axial_damping);
+            }
         }
         d
     }

@@ -25,10 +25,8 @@
 
 use super::LumpedSpatial;
 use cdpr_core::robot::PerCable;
+pub use cdpr_core::robot::reels::REEL_TIME_CONSTANT;
 use nalgebra::Vector3;
-
-/// Time constant τ of a driven reel's velocity loop [s].
-pub const REEL_TIME_CONSTANT: f64 = 1e-4;
 
 /// What moves each cable's stored line.
 #[derive(Debug, Clone, Copy, PartialEq)]
