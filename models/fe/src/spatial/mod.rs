@@ -50,6 +50,9 @@ pub struct FeSpatial {
     /// [`CableModel::drive_reels`].
     length_driven: bool,
     drive: Option<(PerCable, PerCable)>,
+    /// The prescribing forces Q_l,i of the last solve [N] and the state it was at.
+    prescribing: Vec<f64>,
+    prescribing_state: Vec<f64>,
 }
 
 impl FeSpatial {
@@ -133,6 +136,8 @@ impl FeSpatial {
             differences: None,
             length_driven: false,
             drive: None,
+            prescribing: vec![0.0; m],
+            prescribing_state: Vec::new(),
         }
     }
 
@@ -248,6 +253,7 @@ impl FeSpatial {
     /// and its row becomes l_i'' = the command; ρ_i (the reel side, not modelled) stays still.
     fn prescribe_lengths(&self, sys: &mut StarSystem, y: &[f64]) {
         let nn = self.elements - 1;
+        sys.hold_l_rows();
         for cable in 0..self.robot.cables() {
             let a = self.commanded_l_acceleration(y, cable);
             for k in cable * nn..(cable + 1) * nn {
@@ -261,27 +267,20 @@ impl FeSpatial {
     }
 
     /// The force each driven reel needs to impose l_i, Q_l,i = (M q'' − F)_l of the span alone
-    /// (MODELS.md FE.7: d/dt(E_span + E_P) = Σ Q_l,i l_i'), at `y` [N].
+    /// (MODELS.md FE.7: d/dt(E_span + E_P) = Σ Q_l,i l_i'), at `y` [N], assembled and solved
+    /// afresh (each right-hand side keeps its own in `prescribing`).
     fn prescribing_forces(&self, y: &[f64]) -> Vec<f64> {
         let (m, nn) = (self.robot.cables(), self.elements - 1);
         let mut sys = StarSystem::new(m, nn);
         self.assemble_into(&mut sys, y, &vec![0.0; m], false);
-        let original = sys.clone();
         self.prescribe_lengths(&mut sys, y);
         let mut nodes = vec![Vector3::zeros(); m * nn];
         let (mut effector, mut border) = (Vector3::zeros(), vec![[0.0; 2]; m]);
-        if !sys.solve(&mut nodes, &mut effector, &mut border) {
-            return vec![f64::NAN; m];
+        let mut q = vec![f64::NAN; m];
+        if sys.solve(&mut nodes, &mut effector, &mut border) {
+            sys.held_l_residuals(&nodes, &effector, &border, &mut q);
         }
-        (0..m)
-            .map(|c| {
-                let [d_ll, _, _, f_l, _] = original.border[c];
-                let span: f64 = (c * nn..(c + 1) * nn)
-                    .map(|k| original.l_column[k].dot(&nodes[k]))
-                    .sum();
-                span + original.effector_l[c].dot(&effector) + d_ll * border[c][0] - f_l
-            })
-            .collect()
+        q
     }
 
     /// M(q) and F(q, q', T) (FE.5.3) into `sys`: the spans, the stored elements if `stored`
@@ -352,6 +351,16 @@ impl FeSpatial {
             &mut self.border_accelerations,
         ) {
             return false;
+        }
+        if self.length_driven {
+            self.system.held_l_residuals(
+                &self.node_accelerations,
+                &effector,
+                &self.border_accelerations,
+                &mut self.prescribing,
+            );
+            self.prescribing_state.clear();
+            self.prescribing_state.extend_from_slice(y);
         }
         let nodes = self.node_accelerations.len();
         for (j, a) in self.node_accelerations.iter().enumerate() {
@@ -451,12 +460,20 @@ impl CableModel<3> for FeSpatial {
         if !self.length_driven {
             return tensions.dot(reel_speeds);
         }
+        // The closed loop asks right after the right-hand side at the same state, whose
+        // solve kept the forces; anywhere else they are solved afresh.
         let np = self.positions_len();
-        self.prescribing_forces(y)
-            .iter()
-            .enumerate()
-            .map(|(c, q)| q * y[np + self.l_index(c)])
-            .sum()
+        let power = |q: &[f64]| -> f64 {
+            q.iter()
+                .enumerate()
+                .map(|(c, q)| q * y[np + self.l_index(c)])
+                .sum()
+        };
+        if self.prescribing_state.as_slice() == y {
+            power(&self.prescribing)
+        } else {
+            power(&self.prescribing_forces(y))
+        }
     }
 
     fn energy(&self, y: &[f64]) -> Energy {

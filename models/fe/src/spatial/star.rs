@@ -32,6 +32,11 @@ pub struct StarSystem {
     /// The effector's mass entry (M plus its elements' share) [kg] and its force [N].
     pub(super) effector_mass: f64,
     pub(super) effector_force: Vector3<f64>,
+    /// The l rows as assembled, held when the lengths are prescribed ([`Self::hold_l_rows`]):
+    /// the l_i column per node, P's l_i column, and per arm (M_ll, F_l).
+    held_l_column: Vec<Vector3<f64>>,
+    held_effector_l: Vec<Vector3<f64>>,
+    held_l_row: Vec<[f64; 2]>,
     /// Scratch: Thomas multipliers and pivots, u, v, z per node, the reduced system.
     multiplier: Vec<f64>,
     pivot: Vec<f64>,
@@ -57,6 +62,9 @@ impl StarSystem {
             node_effector: vec![0.0; arms],
             effector_l: vec![Vector3::zeros(); arms],
             border: vec![[0.0; 5]; arms],
+            held_l_column: vec![Vector3::zeros(); all],
+            held_effector_l: vec![Vector3::zeros(); arms],
+            held_l_row: vec![[0.0; 2]; arms],
             effector_mass: 0.0,
             effector_force: Vector3::zeros(),
             multiplier: vec![0.0; all],
@@ -80,6 +88,34 @@ impl StarSystem {
         self.border.fill([0.0; 5]);
         self.effector_mass = 0.0;
         self.effector_force = Vector3::zeros();
+    }
+
+    /// Keeps the l rows as assembled, before a prescription of l'' overwrites them.
+    pub fn hold_l_rows(&mut self) {
+        self.held_l_column.copy_from_slice(&self.l_column);
+        self.held_effector_l.copy_from_slice(&self.effector_l);
+        for (held, b) in self.held_l_row.iter_mut().zip(&self.border) {
+            *held = [b[0], b[3]];
+        }
+    }
+
+    /// The held l rows' residual (M q'' − F)_l per arm at the accelerations of a solve (the
+    /// force that imposes each l_i'' there) into `out` [N].
+    pub fn held_l_residuals(
+        &self,
+        nodes: &[Vector3<f64>],
+        effector: &Vector3<f64>,
+        border: &[[f64; 2]],
+        out: &mut [f64],
+    ) {
+        let nn = self.nodes;
+        for (arm, q) in out.iter_mut().enumerate().take(self.arms) {
+            let [m_ll, f_l] = self.held_l_row[arm];
+            let span: f64 = (arm * nn..(arm + 1) * nn)
+                .map(|k| self.held_l_column[k].dot(&nodes[k]))
+                .sum();
+            *q = span + self.held_effector_l[arm].dot(effector) + m_ll * border[arm][0] - f_l;
+        }
     }
 
     /// Arm i's Thomas factorisation of t_i, then u_i, v_i and z_i; false if t_i is not
