@@ -17,13 +17,16 @@
 //! analysed once per run, refactorised only when the modified Newton iteration contracts slowly,
 //! when the iterations a stale matrix costs have paid for a refresh, or when the step changed. A
 //! step whose Newton iteration fails even with a fresh matrix is retried at half the size; the
-//! step grows back after a few successes.
+//! step grows back after a few successes. With an [`ErrorControl`] the step is chosen instead
+//! by the local error estimate of [`crate::alpha_error`], and `step` is only the first one.
 //!
 //! First-order states that ride along (a controller, energy audits) are the system's business: it
 //! updates them from the step's endpoints ([`SecondOrderSystem::end_step`]), e.g. by the trapezoidal
 //! rule. Dense output is the cubic Hermite interpolant of the state and its derivative at both ends
 //! of the step (one right-hand-side evaluation per step), third order, above the method's own.
 
+pub use crate::alpha_coefficients::AlphaCoefficients;
+use crate::alpha_error::{ErrorControl, StepEnds, StepHistory};
 use crate::norms::max_norm;
 use crate::ode::{IntegratorError, SecondOrderSystem, SolverStats, Stepper};
 use crate::sparse::IterationMatrix;
@@ -49,6 +52,9 @@ pub struct GeneralizedAlphaOptions {
     pub slow_contraction: f64,
     /// Smallest step before giving up [s].
     pub min_step: f64,
+    /// Error control: `step` is then the first step, and each step's local error estimate
+    /// chooses the next ([`crate::alpha_error`]); `None`: the fixed step `step`.
+    pub error_control: Option<ErrorControl>,
 }
 
 impl Default for GeneralizedAlphaOptions {
@@ -60,6 +66,7 @@ impl Default for GeneralizedAlphaOptions {
             max_iterations: 8,
             slow_contraction: 0.05,
             min_step: 1e-12,
+            error_control: None,
         }
     }
 }
@@ -77,74 +84,6 @@ const SUCCESSES_BEFORE_GROWTH: u32 = 4;
 /// The matrix is re-evaluated when the step differs from the one it was built for by more than
 /// this ratio (its c_v, c_q scale with h and h²).
 const STEP_CHANGE_REFRESH: f64 = 0.25;
-
-/// The method's coefficients for ρ∞.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AlphaCoefficients {
-    pub alpha_m: f64,
-    pub alpha_f: f64,
-    pub gamma: f64,
-    pub beta: f64,
-}
-
-impl AlphaCoefficients {
-    /// Chung–Hulbert's optimal set for spectral radius ρ∞.
-    pub fn new(rho_inf: f64) -> Self {
-        let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
-        let alpha_f = rho_inf / (rho_inf + 1.0);
-        let gamma = 0.5 + alpha_f - alpha_m;
-        let beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
-        Self {
-            alpha_m,
-            alpha_f,
-            gamma,
-            beta,
-        }
-    }
-
-    /// How the method renders an undamped mode ω [rad/s] at step h [s]: the principal root λ of
-    /// its one-step amplification matrix for q'' = −ω² q gives the discrete frequency arg(λ)/h
-    /// [rad/s] and growth ln|λ|/h [1/s] (< 0: numerical damping). E.g. ρ∞ = 0.9, h = 1e-4 s maps
-    /// the lumped model's 5649 rad/s axial mode to 5503.9 rad/s (MODELS.md FE.9.3: "period-
-    /// elongated"), while the 20.37 rad/s vertical mode keeps its frequency to 1e-5 rad/s.
-    pub fn discrete_mode(&self, omega: f64, h: f64) -> (f64, f64) {
-        // State (q, h q', h² q'', h² a) of one step for unit mass and stiffness ω², by columns.
-        let w2 = (omega * h).powi(2);
-        let (am, af, g, b) = (self.alpha_m, self.alpha_f, self.gamma, self.beta);
-        let k = (1.0 - af) / (1.0 - am);
-        let mut amplification = nalgebra::Matrix4::<f64>::zeros();
-        for j in 0..4 {
-            let mut x = [0.0; 4];
-            x[j] = 1.0;
-            let [q, v, d, a] = x;
-            let history = (af * d - am * a) / (1.0 - am);
-            let predicted = q + v + (0.5 - b) * a + b * history;
-            // Solve q''_{n+1} + ω² q_{n+1} = 0 with q_{n+1} = predicted + β k q''_{n+1}.
-            let d1 = -w2 * predicted / (1.0 + w2 * b * k);
-            let a1 = k * d1 + history;
-            let column = [predicted + b * k * d1, v + (1.0 - g) * a + g * a1, d1, a1];
-            for (i, c) in column.into_iter().enumerate() {
-                amplification[(i, j)] = c;
-            }
-        }
-        let principal = amplification
-            .complex_eigenvalues()
-            .iter()
-            .copied()
-            .max_by(|x, y| x.im.total_cmp(&y.im))
-            .unwrap_or_default();
-        (
-            principal.im.atan2(principal.re) / h,
-            principal.norm().ln() / h,
-        )
-    }
-
-    /// (γ', β') = ∂(q', q)_{n+1}/∂q''_{n+1} for step h.
-    pub fn derivatives(&self, h: f64) -> (f64, f64) {
-        let k = (1.0 - self.alpha_f) / (1.0 - self.alpha_m);
-        (self.gamma * h * k, self.beta * h * h * k)
-    }
-}
 
 /// How one Newton solve ended (converged: after how many iterations).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -176,6 +115,10 @@ pub struct GeneralizedAlpha {
     qdd_try: Vec<f64>,
     a_try: Vec<f64>,
     r: Vec<f64>,
+    /// The candidate's tail rate (error control), and how much of the tail enters the norm.
+    rate_try: Vec<f64>,
+    error_tail: usize,
+    history: StepHistory,
     values: Vec<f64>,
     matrix: Option<IterationMatrix>,
     /// Step the current factorisation was built for (0: none).
@@ -207,6 +150,9 @@ impl GeneralizedAlpha {
             qdd_try: Vec::new(),
             a_try: Vec::new(),
             r: Vec::new(),
+            rate_try: Vec::new(),
+            error_tail: 0,
+            history: StepHistory::default(),
             values: Vec::new(),
             matrix: None,
             matrix_h: 0.0,
@@ -452,18 +398,40 @@ impl GeneralizedAlpha {
         self.y[2 * n..].copy_from_slice(&self.y_prev[2 * n..]);
         self.dy[2 * n..].copy_from_slice(&self.dy_prev[2 * n..]);
         sys.end_step(t1, &mut self.y);
+        self.advance(t1, iterations);
+        sys.tail_rate(self.t, &self.y, &mut self.dy[2 * n..]);
+    }
+
+    /// An error-controlled step to `t1` taken: the candidate, whose tail and its rate
+    /// [`Self::candidate_error`] has already formed, becomes the state.
+    fn accept_candidate(&mut self, t1: f64, iterations: u64) {
+        let n = self.n;
+        std::mem::swap(&mut self.y_prev, &mut self.y);
+        std::mem::swap(&mut self.dy_prev, &mut self.dy);
+        self.y.copy_from_slice(&self.y_try);
+        self.advance(t1, iterations);
+        self.dy[2 * n..].copy_from_slice(&self.rate_try);
+    }
+
+    /// The clock, the accelerations, the derivative's (q', q'') for the dense output (from the
+    /// step, whose q'' satisfies R = 0 to the Newton tolerance) and the counters of an accepted
+    /// step; the tail's rate is the caller's.
+    fn advance(&mut self, t1: f64, iterations: u64) {
+        let n = self.n;
         self.t_prev = self.t;
         self.t = t1;
         std::mem::swap(&mut self.qdd, &mut self.qdd_try);
         std::mem::swap(&mut self.a, &mut self.a_try);
-        // Derivative at the new point for the dense output: (q', q'') from the step, whose
-        // q'' satisfies R = 0 to the Newton tolerance, and the tail's own rate.
         let (dq, rest) = self.dy.split_at_mut(n);
         dq.copy_from_slice(&self.y[n..2 * n]);
         rest[..n].copy_from_slice(&self.qdd);
-        sys.tail_rate(self.t, &self.y, &mut rest[n..]);
         self.stats.steps_accepted += 1;
         self.excess_iterations += iterations.saturating_sub(1);
+    }
+
+    /// After an accepted fixed step: a step reduced by Newton failures grows back toward the
+    /// nominal one after a few successes.
+    fn grow_back(&mut self) {
         if self.h < self.opts.step {
             self.successes += 1;
             if self.successes >= SUCCESSES_BEFORE_GROWTH {
@@ -471,6 +439,34 @@ impl GeneralizedAlpha {
                 self.successes = 0;
             }
         }
+    }
+
+    /// The scaled local error of the converged iterate of a step of size `h` to
+    /// `t1`, after completing the candidate: its tail (the system's rule) and the tail's rate.
+    fn candidate_error<S: SecondOrderSystem + ?Sized>(
+        &mut self,
+        sys: &mut S,
+        t1: f64,
+        control: &ErrorControl,
+        h: f64,
+    ) -> f64 {
+        let n = self.n;
+        sys.end_step(t1, &mut self.y_try);
+        sys.tail_rate(t1, &self.y_try, &mut self.rate_try);
+        let tail = 2 * n..2 * n + self.error_tail;
+        let h_before = self.t - self.t_prev;
+        let ends = StepEnds {
+            q0: &self.y[..n],
+            q1: &self.y_try[..n],
+            qdd0: &self.qdd,
+            qdd1: &self.qdd_try,
+            z0: &self.y[tail.clone()],
+            z1: &self.y_try[tail.clone()],
+            rate0: &self.dy[tail.clone()],
+            rate1: &self.rate_try[..self.error_tail],
+            before: (h_before > 0.0).then(|| (&self.dy_prev[tail], h_before)),
+        };
+        control.scaled_error(self.coeff.error_constant(), h, &ends)
     }
 
     fn initialise<S: SecondOrderSystem + ?Sized>(&mut self, sys: &mut S, t: f64, y: &[f64]) {
@@ -510,6 +506,13 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
                 "step must be > 0 and rho_inf in [0, 1]",
             ));
         }
+        if let Some(c) = self.opts.error_control
+            && !(c.rtol > 0.0 && c.atol >= 0.0 && c.max_step > 0.0)
+        {
+            return Err(IntegratorError::Usage(
+                "error control needs rtol > 0, atol ≥ 0 and max_step > 0",
+            ));
+        }
         self.n = n;
         for v in [
             &mut self.y,
@@ -529,6 +532,9 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
         ] {
             *v = vec![0.0; n];
         }
+        self.rate_try = vec![0.0; dim - 2 * n];
+        self.error_tail = sys.error_len().clamp(2 * n, dim) - 2 * n;
+        self.history = StepHistory::default();
         let pattern = sys.iteration_pattern();
         self.values = vec![0.0; pattern.len()];
         (self.refresh_price, self.excess_iterations) = (0, 0);
@@ -538,7 +544,10 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
             &sys.coupled_unknowns(),
         )?);
         self.matrix_h = 0.0;
-        self.h = self.opts.step;
+        self.h = match self.opts.error_control {
+            Some(control) => self.opts.step.min(control.max_step),
+            None => self.opts.step,
+        };
         self.stats = SolverStats::default();
         self.initialise(sys, t0, y0);
         Ok(())
@@ -562,8 +571,27 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
             let t1 = if last { t_end } else { self.t + h };
             match self.attempt(sys, t1, h)? {
                 Newton::Converged(iterations) => {
-                    self.accept(sys, t1, iterations);
-                    return Ok(());
+                    let Some(control) = self.opts.error_control else {
+                        self.accept(sys, t1, iterations);
+                        self.grow_back();
+                        return Ok(());
+                    };
+                    let error = self.candidate_error(sys, t1, &control, h);
+                    if error <= 1.0 {
+                        self.accept_candidate(t1, iterations);
+                        if !last {
+                            self.h = self.history.accepted(&control, h, error);
+                        }
+                        return Ok(());
+                    }
+                    self.stats.steps_rejected += 1;
+                    self.h = self.history.rejected(h, error);
+                    if self.h < self.opts.min_step {
+                        return Err(IntegratorError::StepSizeUnderflow {
+                            t: self.t,
+                            h: self.h,
+                        });
+                    }
                 }
                 failed => self.reject(failed, h)?,
             }

@@ -33,6 +33,8 @@
 //! assert!((solver.state()[0] - 1.0).abs() < 1e-8);
 //! ```
 
+pub mod alpha_coefficients;
+pub mod alpha_error;
 pub mod differences;
 pub mod dopri5;
 pub mod eigen;
@@ -45,6 +47,7 @@ pub mod riccati;
 pub mod small_cholesky;
 pub mod sparse;
 
+pub use alpha_error::ErrorControl;
 pub use dopri5::{Dopri5, Dopri5Options};
 pub use generalized_alpha::{AlphaCoefficients, GeneralizedAlpha, GeneralizedAlphaOptions};
 pub use ode::{IntegratorError, MatrixCost, OdeSystem, SecondOrderSystem, SolverStats, Stepper};

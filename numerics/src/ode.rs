@@ -176,4 +176,10 @@ pub trait SecondOrderSystem: OdeSystem {
     fn residual_round_off(&self, _y: &[f64]) -> f64 {
         0.0
     }
+    /// The state's first `error_len` components enter an error-controlled integrator's norm
+    /// (q, and the tail up to where audit states begin; the velocities are left to the
+    /// method, see `alpha_error`). Default: all.
+    fn error_len(&self) -> usize {
+        self.dimension()
+    }
 }

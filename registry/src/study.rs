@@ -433,12 +433,14 @@ pub fn eq15_at_end(scenario: &Scenario) -> f64 {
 }
 
 /// How the scenario's integrator renders an undamped mode of frequency `omega` [rad/s]: unchanged
-/// for DOPRI5 at its tolerance, the discrete frequency of generalised-α at the scenario's step and
-/// ρ∞ on the implicit path.
+/// for DOPRI5 at its tolerance, the discrete frequency of generalised-α at the scenario's fixed
+/// step and ρ∞ on the implicit path (an error-controlled step has no single image: there the
+/// mode itself).
 pub fn mode_as_integrated(scenario: &Scenario, omega: f64) -> f64 {
     let sim = &scenario.simulation;
     match sim.integrator {
         IntegratorKind::Dopri5 => omega,
+        IntegratorKind::Implicit if sim.adaptive => omega,
         IntegratorKind::Implicit => {
             AlphaCoefficients::new(sim.rho_inf)
                 .discrete_mode(omega, sim.step)

@@ -225,6 +225,11 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         self.controller_and_audit_rates(y, (&reference, &effector), (&cmd, &reel), out);
     }
 
+    /// The model's and the controller's states; the energy audits stay out of the norm.
+    fn error_len(&self) -> usize {
+        self.dynamic_len()
+    }
+
     fn residual_round_off(&self, y: &[f64]) -> f64 {
         let n = self.model_len();
         self.model

@@ -21,7 +21,8 @@ use crate::model::{CableModel, Equilibrium, ModelEvent};
 use crate::scenario::{ImplicitMethod, IntegratorKind, Scenario};
 use crate::series::{SeriesBuffer, TimeSeries};
 use cdpr_numerics::{
-    Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions, SolverStats, Stepper,
+    Dopri5, Dopri5Options, ErrorControl, GeneralizedAlpha, GeneralizedAlphaOptions, SolverStats,
+    Stepper,
 };
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -102,6 +103,11 @@ impl From<&Scenario> for RunOptions {
                 ImplicitMethod::GeneralizedAlpha => GeneralizedAlphaOptions {
                     step: sim.step,
                     rho_inf: sim.rho_inf,
+                    error_control: sim.adaptive.then(|| ErrorControl {
+                        rtol: sim.rtol,
+                        atol: sim.atol,
+                        max_step: s.largest_implicit_step(),
+                    }),
                     ..GeneralizedAlphaOptions::default()
                 },
             },

@@ -321,10 +321,16 @@ pub struct Simulation {
     pub dopri_beta: f64,
     pub integrator: IntegratorKind,
     pub implicit_method: ImplicitMethod,
-    /// Fixed step of the implicit method [s].
+    /// Fixed step of the implicit method [s], or its first step when `adaptive`.
     pub step: f64,
     /// Spectral radius at infinity of generalized-α.
     pub rho_inf: f64,
+    /// Error control of the implicit method: each step's local error estimate within `rtol` and
+    /// `atol` per second of simulated time chooses the next step (numerics `alpha_error`), up
+    /// to [`Scenario::largest_implicit_step`]. Off by default: the fixed `step` (written into a
+    /// run's provenance only when on, so that today's results stay byte for byte).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub adaptive: bool,
 }
 
 impl Default for Simulation {
@@ -339,6 +345,7 @@ impl Default for Simulation {
             implicit_method: ImplicitMethod::GeneralizedAlpha,
             step: 1e-4,
             rho_inf: 0.9,
+            adaptive: false,
         }
     }
 }

@@ -171,6 +171,14 @@ impl Scenario {
                 ));
             }
         }
+        if s.adaptive && s.integrator != IntegratorKind::Implicit {
+            return Err(out_of_range(
+                "simulation.adaptive",
+                s.adaptive,
+                "false with integrator = \"dopri5\" (DOPRI5 always controls its error; \
+                 `adaptive` switches the implicit integrator's error control on)",
+            ));
+        }
         finite("simulation.rho_inf", s.rho_inf)?;
         if !(0.0..=1.0).contains(&s.rho_inf) {
             return Err(out_of_range("simulation.rho_inf", s.rho_inf, "[0, 1]"));
