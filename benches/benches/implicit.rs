@@ -4,6 +4,8 @@
 //! - `implicit/{lumped,fe}_paper_run_5s`: the paper's 5 s run as the scenario defines it (samples
 //!   every 1e-5 s into a reused buffer), and `…_5s_coarse_samples` with samples every 1e-4 s (one
 //!   per step), which isolates the integrator from the 500 001-row output;
+//! - `implicit_adaptive/{lumped,fe}_paper_run_5s`: the same runs under error control at the
+//!   tolerances that reach the fixed step's accuracy;
 //! - `implicit_cost_vs_n/{lumped,fe}/N`, N = 10 … 1000: 0.02 s of the paper's run from its
 //!   static equilibrium (200 steps, one sample per step; the equilibrium is solved once, outside
 //!   the timing). Criterion's time × 50 is the cost per simulated second.
@@ -57,6 +59,45 @@ fn paper_runs(c: &mut Criterion) {
                 })
             });
         }
+    }
+    group.finish();
+}
+
+/// The paper's 5 s runs under error control (`adaptive = true`, samples every 1e-4 s as in
+/// `…_coarse_samples`), at the loosest tolerances measured to reach the accuracy of the fixed
+/// h = 1e-4 s run (T1 min within 1e-3 N, z p2p within 1e-3 relative, the settled error within
+/// 1e-7 m, docs/numerics.md): FE at the defaults (rtol 1e-5, atol 1e-9), lumped at atol 1e-6
+/// (its nodes by the pulleys make atol 1e-9 cost 2 M steps).
+fn adaptive_runs(c: &mut Criterion) {
+    let mut group = c.benchmark_group("implicit_adaptive");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(30));
+    for (kind, atol) in [(ModelKind::Lumped, 1e-6), (ModelKind::Fe, 1e-9)] {
+        let mut s = scenario(kind, None);
+        s.simulation.sample_period = 1e-4;
+        s.simulation.adaptive = true;
+        s.simulation.atol = atol;
+        let opts = RunOptions::from(&s);
+        let mut buffer = SeriesBuffer::default();
+        if std::env::var_os("CDPR_BENCH_STATS").is_some() {
+            let mut sys = ClosedLoop::new(build(&s).unwrap(), &s).unwrap();
+            let run =
+                simulate_reusing(&mut sys, &opts, SeriesBuffer::default(), &mut |_| {}).unwrap();
+            eprintln!("{kind} adaptive: {:?}", run.stats);
+        }
+        group.bench_function(format!("{kind}_paper_run_5s"), |b| {
+            b.iter(|| {
+                let model = build(&s).unwrap();
+                let mut sys = ClosedLoop::new(model, &s).unwrap();
+                let run =
+                    simulate_reusing(&mut sys, &opts, std::mem::take(&mut buffer), &mut |_| {})
+                        .unwrap();
+                let steps = run.stats.steps_accepted;
+                buffer = run.series.into_buffer();
+                black_box(steps)
+            })
+        });
     }
     group.finish();
 }
@@ -139,5 +180,5 @@ fn cost_vs_n(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, paper_runs, cost_vs_n);
+criterion_group!(benches, paper_runs, adaptive_runs, cost_vs_n);
 criterion_main!(benches);

@@ -1,6 +1,6 @@
 //! `cargo xtask work-precision`: error of the effector trajectory against a tight-tolerance
-//! reference versus cost, for DOPRI5 (rtol sweep) and generalised-α (step sweep) on both
-//! massive-cable models → `work_precision.csv` and the figure `work_precision.{svg,png}`.
+//! reference versus cost, for DOPRI5 (rtol sweep), generalised-α at a fixed step (step sweep)
+//! and generalised-α under error control (tolerance sweep) on both massive-cable models → `work_precision.csv` and the figure `work_precision.{svg,png}`.
 //!
 //! The horizon is the transition and 50 ms of settling, [0, 0.25] s: it contains every pulley
 //! event of the transition, and ends before the lumped model's first "hovering" node (≈ 0.29 s),
@@ -25,14 +25,48 @@ const SAMPLE_PERIOD: f64 = 1e-4;
 /// DOPRI5 relative tolerances (atol = 1e-4·rtol) and generalised-α steps [s] (ρ∞ = 0.9).
 const RTOLS: [f64; 5] = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8];
 const STEPS: [f64; 6] = [4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5, 1.25e-5];
+/// Error-controlled generalised-α tolerances (rtol = atol).
+const TOLS: [f64; 5] = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8];
+
+/// How a point was integrated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Method {
+    Dopri5,
+    /// Generalised-α at a fixed step.
+    FixedAlpha,
+    /// Generalised-α under error control (`adaptive = true`).
+    AdaptiveAlpha,
+}
+
+impl Method {
+    const ALL: [Method; 3] = [Method::Dopri5, Method::FixedAlpha, Method::AdaptiveAlpha];
+
+    /// The CSV's spelling.
+    fn name(self) -> &'static str {
+        match self {
+            Method::Dopri5 => "dopri5",
+            Method::FixedAlpha => "implicit",
+            Method::AdaptiveAlpha => "implicit-adaptive",
+        }
+    }
+
+    /// The figure's legend.
+    fn label(self) -> &'static str {
+        match self {
+            Method::Dopri5 => "DOPRI5",
+            Method::FixedAlpha => "generalised-α, fixed h",
+            Method::AdaptiveAlpha => "generalised-α, error-controlled",
+        }
+    }
+}
 /// The reference: DOPRI5 at rtol 1e-10, atol 1e-14.
 const REFERENCE_RTOL: f64 = 1e-10;
 
 /// One point of the study.
 struct Point {
     model: ModelKind,
-    integrator: IntegratorKind,
-    /// rtol (DOPRI5) or step [s] (implicit).
+    method: Method,
+    /// rtol (DOPRI5, error-controlled generalised-α) or step [s] (fixed generalised-α).
     parameter: f64,
     error: f64,
     wall_s: f64,
@@ -42,18 +76,27 @@ struct Point {
     factorisations: u64,
 }
 
-fn scenario(model: ModelKind, integrator: IntegratorKind, parameter: f64) -> Result<Scenario> {
+fn scenario(model: ModelKind, method: Method, parameter: f64) -> Result<Scenario> {
     let mut s = Scenario::paper();
     s.model = model.into();
     s.simulation.t_final = HORIZON;
     s.simulation.sample_period = SAMPLE_PERIOD;
-    s.simulation.integrator = integrator;
-    match integrator {
-        IntegratorKind::Dopri5 => {
-            s.simulation.rtol = parameter;
-            s.simulation.atol = 1e-4 * parameter;
+    let sim = &mut s.simulation;
+    match method {
+        Method::Dopri5 => {
+            sim.rtol = parameter;
+            sim.atol = 1e-4 * parameter;
         }
-        IntegratorKind::Implicit => s.simulation.step = parameter,
+        Method::FixedAlpha => {
+            sim.integrator = IntegratorKind::Implicit;
+            sim.step = parameter;
+        }
+        Method::AdaptiveAlpha => {
+            sim.integrator = IntegratorKind::Implicit;
+            sim.adaptive = true;
+            sim.rtol = parameter;
+            sim.atol = parameter;
+        }
     }
     cdpr_bench::validate(&s)?;
     Ok(s)
@@ -95,19 +138,20 @@ pub fn run_study(out: &Path) -> Result<()> {
 /// each of [`STEPS`].
 fn model_points(model: ModelKind) -> Result<Vec<Point>> {
     eprintln!("{model}: reference (DOPRI5, rtol {REFERENCE_RTOL:e})");
-    let mut reference_scenario = scenario(model, IntegratorKind::Dopri5, REFERENCE_RTOL)?;
+    let mut reference_scenario = scenario(model, Method::Dopri5, REFERENCE_RTOL)?;
     reference_scenario.simulation.atol = 1e-14;
     let reference = cdpr_bench::simulate(&reference_scenario, &mut |_| {})?;
     let sweeps = RTOLS
         .iter()
-        .map(|&p| (IntegratorKind::Dopri5, p))
-        .chain(STEPS.iter().map(|&p| (IntegratorKind::Implicit, p)));
+        .map(|&p| (Method::Dopri5, p))
+        .chain(STEPS.iter().map(|&p| (Method::FixedAlpha, p)))
+        .chain(TOLS.iter().map(|&p| (Method::AdaptiveAlpha, p)));
     let mut points = Vec::new();
-    for (integrator, parameter) in sweeps {
-        let r = run(&scenario(model, integrator, parameter)?)?;
+    for (method, parameter) in sweeps {
+        let r = run(&scenario(model, method, parameter)?)?;
         let point = Point {
             model,
-            integrator,
+            method,
             parameter,
             error: error(&r, &reference)?,
             wall_s: r.wall_s,
@@ -118,7 +162,7 @@ fn model_points(model: ModelKind) -> Result<Vec<Point>> {
         };
         eprintln!(
             "{model} {} {parameter:e}: error {:.3e} m, {:.4} s, {} RHS",
-            point.integrator.name(),
+            point.method.name(),
             point.error,
             point.wall_s,
             point.rhs_evals
@@ -139,7 +183,7 @@ fn write_csv(path: &Path, points: &[Point]) -> Result<()> {
                 w,
                 "{},{},{},{},{},{},{},{},{}",
                 p.model,
-                p.integrator.name(),
+                p.method.name(),
                 p.parameter,
                 p.error,
                 p.wall_s,
@@ -164,25 +208,21 @@ fn write_figure(points: &[Point], out: &Path) -> Result<()> {
         lines: ModelKind::MASSIVE
             .into_iter()
             .flat_map(|model| {
-                [IntegratorKind::Dopri5, IntegratorKind::Implicit]
-                    .into_iter()
-                    .map(move |integrator| Line {
-                        label: format!(
-                            "{model}, {}",
-                            match integrator {
-                                IntegratorKind::Dopri5 => "DOPRI5",
-                                IntegratorKind::Implicit => "generalised-α",
-                            }
-                        ),
-                        color: figures::model_color(model),
-                        dashed: integrator == IntegratorKind::Implicit,
-                        width: figures::LINE_WIDTH,
-                        points: points
-                            .iter()
-                            .filter(|p| p.model == model && p.integrator == integrator)
-                            .map(|p| (f(p), p.error.max(1e-16)))
-                            .collect(),
-                    })
+                Method::ALL.into_iter().map(move |method| Line {
+                    label: format!("{model}, {}", method.label()),
+                    color: figures::model_color(model),
+                    dashed: method == Method::FixedAlpha,
+                    width: if method == Method::AdaptiveAlpha {
+                        2.0 * figures::LINE_WIDTH
+                    } else {
+                        figures::LINE_WIDTH
+                    },
+                    points: points
+                        .iter()
+                        .filter(|p| p.model == model && p.method == method)
+                        .map(|p| (f(p), p.error.max(1e-16)))
+                        .collect(),
+                })
             })
             .collect(),
         markers: Vec::new(),
@@ -191,7 +231,7 @@ fn write_figure(points: &[Point], out: &Path) -> Result<()> {
         &Figure {
             name: "work_precision".into(),
             title:
-                "Work–precision over [0, 0.25] s: DOPRI5 rtol 1e-4 … 1e-8, generalised-α (ρ∞ = 0.9) h 4e-4 … 1.25e-5 s"
+                "Work–precision over [0, 0.25] s: DOPRI5 rtol 1e-4 … 1e-8, generalised-α (ρ∞ = 0.9) h 4e-4 … 1.25e-5 s and tol 1e-4 … 1e-8 (thick)"
                     .into(),
             panels: vec![
                 panel("wall time [s]", |p| p.wall_s),
