@@ -35,6 +35,32 @@ fn scenario(kind: ModelKind, elements: Option<i64>) -> Scenario {
     s
 }
 
+/// One 5 s run of `s` per iteration, its samples in a reused buffer (the solver's counters
+/// printed first with `CDPR_BENCH_STATS`).
+fn bench_paper_run(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    s: &Scenario,
+) {
+    let opts = RunOptions::from(s);
+    let mut buffer = SeriesBuffer::default();
+    let run_once = |buffer: SeriesBuffer| {
+        let mut sys = ClosedLoop::new(build(s).unwrap(), s).unwrap();
+        simulate_reusing(&mut sys, &opts, buffer, &mut |_| {}).unwrap()
+    };
+    if std::env::var_os("CDPR_BENCH_STATS").is_some() {
+        eprintln!("{name}: {:?}", run_once(SeriesBuffer::default()).stats);
+    }
+    group.bench_function(name, |b| {
+        b.iter(|| {
+            let run = run_once(std::mem::take(&mut buffer));
+            let steps = run.stats.steps_accepted;
+            buffer = run.series.into_buffer();
+            black_box(steps)
+        })
+    });
+}
+
 fn paper_runs(c: &mut Criterion) {
     let mut group = c.benchmark_group("implicit");
     group
@@ -44,20 +70,7 @@ fn paper_runs(c: &mut Criterion) {
         for (label, sample_period) in [("", 1e-5), ("_coarse_samples", 1e-4)] {
             let mut s = scenario(kind, None);
             s.simulation.sample_period = sample_period;
-            let opts = RunOptions::from(&s);
-            let mut buffer = SeriesBuffer::default();
-            group.bench_function(format!("{kind}_paper_run_5s{label}"), |b| {
-                b.iter(|| {
-                    let model = build(&s).unwrap();
-                    let mut sys = ClosedLoop::new(model, &s).unwrap();
-                    let run =
-                        simulate_reusing(&mut sys, &opts, std::mem::take(&mut buffer), &mut |_| {})
-                            .unwrap();
-                    let evals = run.stats.rhs_evals;
-                    buffer = run.series.into_buffer();
-                    black_box(evals)
-                })
-            });
+            bench_paper_run(&mut group, &format!("{kind}_paper_run_5s{label}"), &s);
         }
     }
     group.finish();
@@ -78,26 +91,7 @@ fn adaptive_runs(c: &mut Criterion) {
         s.simulation.sample_period = 1e-4;
         s.simulation.adaptive = true;
         s.simulation.atol = atol;
-        let opts = RunOptions::from(&s);
-        let mut buffer = SeriesBuffer::default();
-        if std::env::var_os("CDPR_BENCH_STATS").is_some() {
-            let mut sys = ClosedLoop::new(build(&s).unwrap(), &s).unwrap();
-            let run =
-                simulate_reusing(&mut sys, &opts, SeriesBuffer::default(), &mut |_| {}).unwrap();
-            eprintln!("{kind} adaptive: {:?}", run.stats);
-        }
-        group.bench_function(format!("{kind}_paper_run_5s"), |b| {
-            b.iter(|| {
-                let model = build(&s).unwrap();
-                let mut sys = ClosedLoop::new(model, &s).unwrap();
-                let run =
-                    simulate_reusing(&mut sys, &opts, std::mem::take(&mut buffer), &mut |_| {})
-                        .unwrap();
-                let steps = run.stats.steps_accepted;
-                buffer = run.series.into_buffer();
-                black_box(steps)
-            })
-        });
+        bench_paper_run(&mut group, &format!("{kind}_paper_run_5s"), &s);
     }
     group.finish();
 }
