@@ -364,19 +364,20 @@ impl GeneralizedAlpha {
         Ok(outcome)
     }
 
-    /// A failed attempt of size `h`: the step halved, or the error that ends the run when it
-    /// would fall below the minimum.
-    fn reject(&mut self, failed: Newton, h: f64) -> Result<(), IntegratorError> {
+    /// A failed attempt (Newton's, or the error test's): the next attempt at `h_new`, or the
+    /// error that ends the run when that falls below the minimum (`non_finite`: the component
+    /// whose residual was not finite, if that was the failure).
+    fn reject(&mut self, h_new: f64, non_finite: Option<usize>) -> Result<(), IntegratorError> {
         self.stats.steps_rejected += 1;
         self.successes = 0;
-        self.h = 0.5 * h;
+        self.h = h_new;
         if self.h < self.opts.min_step {
-            return Err(match failed {
-                Newton::NonFinite(component) => IntegratorError::NonFinite {
+            return Err(match non_finite {
+                Some(component) => IntegratorError::NonFinite {
                     t: self.t,
                     component,
                 },
-                _ => IntegratorError::StepSizeUnderflow {
+                None => IntegratorError::StepSizeUnderflow {
                     t: self.t,
                     h: self.h,
                 },
@@ -584,16 +585,11 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
                         }
                         return Ok(());
                     }
-                    self.stats.steps_rejected += 1;
-                    self.h = self.history.rejected(h, error);
-                    if self.h < self.opts.min_step {
-                        return Err(IntegratorError::StepSizeUnderflow {
-                            t: self.t,
-                            h: self.h,
-                        });
-                    }
+                    let h_new = self.history.rejected(h, error);
+                    self.reject(h_new, None)?;
                 }
-                failed => self.reject(failed, h)?,
+                Newton::NonFinite(component) => self.reject(0.5 * h, Some(component))?,
+                Newton::Slow => self.reject(0.5 * h, None)?,
             }
         }
     }

@@ -85,8 +85,7 @@ pub(crate) fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Er
     let config = ModelConfig::from_scenario(scenario)?;
     match config.kind {
         ModelKind::Elastic => cdpr_elastic::Params {}.validate(scenario)?,
-        ModelKind::Lumped => check_lumped(scenario, &robot)?,
-        ModelKind::Fe => check_fe(scenario, &robot)?,
+        ModelKind::Lumped | ModelKind::Fe => check_massive(scenario, &robot, config.kind)?,
     }
     match config.kind {
         ModelKind::Lumped => {
@@ -100,18 +99,25 @@ pub(crate) fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Er
     Ok((robot, config.kind))
 }
 
-/// What the spatial lumped cables run: three or more cables, on reels pulled by tension, or
-/// driven by length on DOPRI5.
-fn check_lumped(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
+/// What the spatial massive cables (`kind`: lumped or FE) run: three or more cables, on reels
+/// pulled by tension, or driven by length on DOPRI5 (lumped: the passage rate of nodes; FE: Du's
+/// prescribed free lengths).
+fn check_massive(scenario: &Scenario, robot: &Robot<3>, kind: ModelKind) -> Result<(), Error> {
     use cdpr_core::scenario::{ControllerKind, IntegratorKind};
-    let refuse = |key: &'static str, value: String, allowed: &str| -> Result<(), Error> {
-        Err(out_of_range(key, value, allowed.to_owned()).into())
+    let refuse = |key: &'static str, value: String, allowed: String| -> Result<(), Error> {
+        Err(out_of_range(key, value, allowed).into())
+    };
+    let label = match kind {
+        ModelKind::Fe => "FE",
+        _ => kind.name(),
     };
     if robot.cables() < 3 {
         return refuse(
             "robot.anchors",
-            format!("{} anchors with model.kind = \"lumped\"", robot.cables()),
-            "3 to 8 anchors for the spatial lumped cables (two cables in space run elastic)",
+            format!("{} anchors with model.kind = \"{kind}\"", robot.cables()),
+            format!(
+                "3 to 8 anchors for the spatial {label} cables (two cables in space run elastic)"
+            ),
         );
     }
     if scenario.controller.kind == ControllerKind::Length
@@ -119,36 +125,10 @@ fn check_lumped(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
     {
         return refuse(
             "simulation.integrator",
-            "\"implicit\" with controller.kind = \"length\" and model.kind = \"lumped\"".into(),
+            format!("\"implicit\" with controller.kind = \"length\" and model.kind = \"{kind}\""),
             "\"dopri5\": reels driven by length on massive cables run on DOPRI5 (the reel's \
-             velocity loop is not in the second-order form)",
-        );
-    }
-    Ok(())
-}
-
-/// What the spatial FE cables run: three or more cables, on reels pulled by tension, or driven
-/// by length (Du's prescribed free lengths) on DOPRI5.
-fn check_fe(scenario: &Scenario, robot: &Robot<3>) -> Result<(), Error> {
-    use cdpr_core::scenario::{ControllerKind, IntegratorKind};
-    let refuse = |key: &'static str, value: String, allowed: &str| -> Result<(), Error> {
-        Err(out_of_range(key, value, allowed.to_owned()).into())
-    };
-    if robot.cables() < 3 {
-        return refuse(
-            "robot.anchors",
-            format!("{} anchors with model.kind = \"fe\"", robot.cables()),
-            "3 to 8 anchors for the spatial FE cables (two cables in space run elastic)",
-        );
-    }
-    if scenario.controller.kind == ControllerKind::Length
-        && scenario.simulation.integrator == IntegratorKind::Implicit
-    {
-        return refuse(
-            "simulation.integrator",
-            "\"implicit\" with controller.kind = \"length\" and model.kind = \"fe\"".into(),
-            "\"dopri5\": reels driven by length on massive cables run on DOPRI5 (the reel's \
-             velocity loop is not in the second-order form)",
+             velocity loop is not in the second-order form)"
+                .into(),
         );
     }
     Ok(())

@@ -325,9 +325,9 @@ pub struct Simulation {
     pub step: f64,
     /// Spectral radius at infinity of generalized-α.
     pub rho_inf: f64,
-    /// Error control of the implicit method: each step's local error estimate within `rtol` and
-    /// `atol` per second of simulated time chooses the next step (numerics `alpha_error`), up
-    /// to [`Scenario::largest_implicit_step`]. Off by default: the fixed `step` (written into a
+    /// Error control of the implicit method: each step's local error estimate, held within
+    /// √rtol × (atol + rtol |q|), chooses the next step (numerics `alpha_error`), up to
+    /// [`Scenario::largest_implicit_step`]. Off by default: the fixed `step` (written into a
     /// run's provenance only when on, so that today's results stay byte for byte).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub adaptive: bool,
