@@ -100,8 +100,8 @@ pub(crate) fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Er
 }
 
 /// What the spatial massive cables (`kind`: lumped or FE) run: three or more cables, on reels
-/// pulled by tension, or driven by length on DOPRI5 (lumped: the passage rate of nodes; FE: Du's
-/// prescribed free lengths).
+/// pulled by tension or driven by length (lumped: the passage rate of nodes, on either
+/// integrator; FE: Du's prescribed free lengths, on DOPRI5).
 fn check_massive(scenario: &Scenario, robot: &Robot<3>, kind: ModelKind) -> Result<(), Error> {
     use cdpr_core::scenario::{ControllerKind, IntegratorKind};
     let refuse = |key: &'static str, value: String, allowed: String| -> Result<(), Error> {
@@ -120,14 +120,15 @@ fn check_massive(scenario: &Scenario, robot: &Robot<3>, kind: ModelKind) -> Resu
             ),
         );
     }
-    if scenario.controller.kind == ControllerKind::Length
+    if kind == ModelKind::Fe
+        && scenario.controller.kind == ControllerKind::Length
         && scenario.simulation.integrator == IntegratorKind::Implicit
     {
         return refuse(
             "simulation.integrator",
             format!("\"implicit\" with controller.kind = \"length\" and model.kind = \"{kind}\""),
-            "\"dopri5\": reels driven by length on massive cables run on DOPRI5 (the reel's \
-             velocity loop is not in the second-order form)"
+            "\"dopri5\": reels driven by length on FE cables run on DOPRI5 (the reel's \
+             velocity loop is not in the FE second-order form)"
                 .into(),
         );
     }

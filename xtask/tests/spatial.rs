@@ -208,8 +208,8 @@ fn flex_error_writes_a_consistent_record() {
 }
 
 /// Refused before any file: a reference the box cannot follow (named with time, pose, cable),
-/// a robot described for its statics only (no move), the FE cables in space, and lumped lines
-/// too short for the move, reeled into the workspace or on length reels on the implicit path.
+/// a robot described for its statics only (no move), FE cables on length reels on the implicit
+/// path, and lumped lines too short for the move or reeled into the workspace.
 #[test]
 fn spatial_runs_are_refused_before_any_file() {
     let dir = TempDir::new("spatial-refusals");
@@ -222,9 +222,6 @@ fn spatial_runs_are_refused_before_any_file() {
         "effector_mass = 1.0",
         "effector_mass = 1.0\nreel_directions = [[0, -1, 0], [1, 1, 0], [-1, 0, 0], [0, 0, -1]]",
     );
-    let length = long(model("kind = \"lumped\""))
-        .replace("\"computed-torque\"", "\"length\"")
-        .replace("[simulation]", "[simulation]\nintegrator = \"implicit\"");
 
     for (file, text, expected) in [
         ("fast.toml", fast, "wrench-feasible workspace at t ="),
@@ -241,7 +238,6 @@ fn spatial_runs_are_refused_before_any_file() {
             "cable.modelled_length",
         ),
         ("inward.toml", inward, "robot.reel_directions"),
-        ("length.toml", length, "simulation.integrator"),
     ] {
         let path = dir.join(file);
         std::fs::write(&path, text).unwrap();

@@ -42,6 +42,12 @@ pub trait SecondOrderForm {
     fn smooth_reach(&self, _state: &[f64], out: &mut [f64]) {
         out.fill(f64::INFINITY);
     }
+    /// Whether R carries reels driven by length, as the model's right-hand side does after
+    /// `CableModel::drive_reels` (the closed loop drives them at each residual's time). A form
+    /// without them cannot run the `length` controller on the implicit path.
+    fn follows_driven_reels(&self) -> bool {
+        false
+    }
 
     /// R = M(q) q'' − F(q, q', T) for state `[q | q']` into `r` (n).
     fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: &[f64], r: &mut [f64]);

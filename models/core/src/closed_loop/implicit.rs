@@ -24,9 +24,21 @@ pub(super) struct StepStart<const D: usize> {
     /// W and D at t_n [J].
     work: f64,
     dissipated: f64,
+    /// The time the model's reels were last driven at (reels driven by length): the Newton
+    /// iterations of a step evaluate at one time, so the commanded lengths' rates (three
+    /// distributions) are computed once per time.
+    pub(super) driven_at: Option<f64>,
 }
 
 impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
+    /// Hands the model the commanded lengths' rates at t when its reels are driven by length
+    /// (as the right-hand side does), unless this step already did at t.
+    fn drive_reels_at(&mut self, t: f64) {
+        if self.drives_reels_by_length() && self.step_start.driven_at != Some(t) {
+            self.drive_reels(t);
+        }
+    }
+
     /// The command at the end t of the current implicit step for the effector state `effector`,
     /// and the controller states advanced there from the step's start (into `states`).
     fn step_end_command(
@@ -132,6 +144,8 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
     }
 
     fn begin_step(&mut self, t: f64, y: &[f64], h: f64) {
+        self.step_start.driven_at = None;
+        self.drive_reels_at(t);
         let n = self.model_len();
         let c = self.controller_len();
         let model_state = &y[..n];
@@ -153,6 +167,7 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
     }
 
     fn residual(&mut self, t: f64, y: &[f64], qdd: &[f64], r: &mut [f64]) {
+        self.drive_reels_at(t);
         let n = self.model_len();
         let effector = self.model.effector(&y[..n]);
         let mut states = [0.0; MAX_CONTROLLER_STATES];
@@ -171,6 +186,7 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         c_q: f64,
         values: &mut [f64],
     ) -> MatrixCost {
+        self.drive_reels_at(t);
         let n = self.model_len();
         let effector = self.model.effector(&y[..n]);
         let mut states = [0.0; MAX_CONTROLLER_STATES];
@@ -217,6 +233,7 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
     }
 
     fn tail_rate(&mut self, t: f64, y: &[f64], out: &mut [f64]) {
+        self.drive_reels_at(t);
         let n = self.model_len();
         let effector = self.model.effector(&y[..n]);
         let reference = self.reference(t);
@@ -238,6 +255,7 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
     }
 
     fn end_step(&mut self, t: f64, y: &mut [f64]) {
+        self.drive_reels_at(t);
         let n = self.model_len();
         let c = self.controller_len();
         let effector = self.model.effector(&y[..n]);

@@ -158,6 +158,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         let accelerations =
             PerCable::from_fn(m, |i| (ahead[i] - 2.0 * now[i] + behind[i]) / (h * h));
         self.model.drive_reels(&rates, &accelerations);
+        self.step_start.driven_at = Some(t);
     }
 
     /// The robot.

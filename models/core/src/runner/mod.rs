@@ -349,12 +349,18 @@ fn unsupported<M: CableModel<D>, const D: usize>(
             model: sys.model.name(),
             why: "the model offers no second-order form",
         })
-    } else if opts.integrator == IntegratorKind::Implicit && sys.drives_reels_by_length() {
+    } else if opts.integrator == IntegratorKind::Implicit
+        && sys.drives_reels_by_length()
+        && !sys
+            .model
+            .second_order()
+            .is_some_and(|f| f.follows_driven_reels())
+    {
         Some(RunError::Unsupported {
             integrator: IntegratorKind::Implicit.name(),
             model: sys.model.name(),
-            why: "reels driven by length on massive cables run on DOPRI5 (the reel's velocity \
-                  loop is not in the second-order form)",
+            why: "reels driven by length on this model run on DOPRI5 (the reel's velocity \
+                  loop is not in its second-order form)",
         })
     } else {
         None

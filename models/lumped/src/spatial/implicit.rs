@@ -3,7 +3,8 @@
 //! projected on its reel line r_i, so its rows across the line read m q''_⊥ = 0 and it stays on
 //! the line; a locked reel end has none, so its rows read m q'' = 0). The iteration matrix is
 //! diag(m) plus the springs' analytic tangent stiffness for undamped cables, coloured central
-//! differences for damped ones. Its pattern is the chains': each node's 3 × 3 block couples only to its two
+//! differences for damped ones; a reel driven by length adds its velocity loop's ∂R/∂q' on the
+//! stored nodes ([`super::reel`]). Its pattern is the chains': each node's 3 × 3 block couples only to its two
 //! neighbours along its cable (the straddling spring's ends are neighbours too), the effector to
 //! the last node of every cable — the star of m arms meeting at the effector. The pattern does
 //! not depend on which nodes are stored, so pulley events never change it.
@@ -157,6 +158,32 @@ impl LumpedSpatial {
         self.implicit.forces = f;
     }
 
+    /// Whether the reels move the stored lines by the velocity loop of [`super::reel`].
+    fn reels_driven(&self) -> bool {
+        matches!(self.drive, super::reel::ReelDrive::Length { .. })
+    }
+
+    /// A reel driven by length gives each stored node a_j = v̇_i + (v_i − q'_j·r_i)/τ along
+    /// r_i, so c_v ∂R/∂q'_j = c_v m r_i r_iᵀ/τ on its own block (v_i's dependence on the
+    /// straddling spring's stretch, c_q m l̇0 ∂λ/∂q /(τ l0), is ~1e-3 of the mass at h = 1e-4 s
+    /// and stays out, as Newton allows).
+    fn add_reel_loop(&self, c_v: f64, values: &mut [f64]) {
+        if !self.reels_driven() {
+            return;
+        }
+        let g = c_v * self.node_mass / super::reel::REEL_TIME_CONSTANT;
+        for cable in 0..self.robot().cables() {
+            let reel = self.reels[cable];
+            for j in 0..self.stored[cable] {
+                for r in 0..3 {
+                    for c in 0..3 {
+                        values[self.pattern_index(cable, j, j, r, c)] += g * reel[r] * reel[c];
+                    }
+                }
+            }
+        }
+    }
+
     /// S by coloured central differences of the residual (any damping).
     pub(super) fn differenced_matrix(
         &mut self,
@@ -177,7 +204,11 @@ impl LumpedSpatial {
             }
         };
         self.smooth_reach(state, differences.step_limits_mut());
-        let c_v = if self.damping == 0.0 { 0.0 } else { c_v };
+        let c_v = if self.damping == 0.0 && !self.reels_driven() {
+            0.0
+        } else {
+            c_v
+        };
         let evals = differences.fill(
             &mut |s, a, r| self.residual_into(s, a, tensions, r),
             state,
@@ -242,6 +273,11 @@ impl SecondOrderForm for LumpedSpatial {
         spring_round_off(self.stiffness, &state[..self.positions_len()])
     }
 
+    /// The stored nodes' rows are the reel's acceleration ([`super::reel`]) when driven.
+    fn follows_driven_reels(&self) -> bool {
+        true
+    }
+
     /// As the planar model's: a quarter of the smallest |λ − l0| of the springs at a node, and
     /// ε^(1/3) of the distance to the pulley at the straddling spring's ends.
     fn smooth_reach(&self, state: &[f64], out: &mut [f64]) {
@@ -281,6 +317,7 @@ impl SecondOrderForm for LumpedSpatial {
         values: &mut [f64],
     ) -> MatrixCost {
         if self.damping == 0.0 && self.tangent_matrix(state, c_q, values) {
+            self.add_reel_loop(c_v, values);
             return MatrixCost::without_residuals(TANGENT_REFRESH_PRICE);
         }
         self.differenced_matrix(state, qdd, tensions, c_v, c_q, values)
