@@ -85,7 +85,7 @@ pub(crate) fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Er
     let config = ModelConfig::from_scenario(scenario)?;
     match config.kind {
         ModelKind::Elastic => cdpr_elastic::Params {}.validate(scenario)?,
-        ModelKind::Lumped | ModelKind::Fe => check_massive(scenario, &robot, config.kind)?,
+        ModelKind::Lumped | ModelKind::Fe => check_massive(&robot, config.kind)?,
     }
     match config.kind {
         ModelKind::Lumped => {
@@ -100,10 +100,9 @@ pub(crate) fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Er
 }
 
 /// What the spatial massive cables (`kind`: lumped or FE) run: three or more cables, on reels
-/// pulled by tension or driven by length (lumped: the passage rate of nodes, on either
-/// integrator; FE: Du's prescribed free lengths, on DOPRI5).
-fn check_massive(scenario: &Scenario, robot: &Robot<3>, kind: ModelKind) -> Result<(), Error> {
-    use cdpr_core::scenario::{ControllerKind, IntegratorKind};
+/// pulled by tension or driven by length (lumped: the passage rate of nodes; FE: Du's prescribed
+/// free lengths), on either integrator.
+fn check_massive(robot: &Robot<3>, kind: ModelKind) -> Result<(), Error> {
     let refuse = |key: &'static str, value: String, allowed: String| -> Result<(), Error> {
         Err(out_of_range(key, value, allowed).into())
     };
@@ -118,18 +117,6 @@ fn check_massive(scenario: &Scenario, robot: &Robot<3>, kind: ModelKind) -> Resu
             format!(
                 "3 to 8 anchors for the spatial {label} cables (two cables in space run elastic)"
             ),
-        );
-    }
-    if kind == ModelKind::Fe
-        && scenario.controller.kind == ControllerKind::Length
-        && scenario.simulation.integrator == IntegratorKind::Implicit
-    {
-        return refuse(
-            "simulation.integrator",
-            format!("\"implicit\" with controller.kind = \"length\" and model.kind = \"{kind}\""),
-            "\"dopri5\": reels driven by length on FE cables run on DOPRI5 (the reel's \
-             velocity loop is not in the FE second-order form)"
-                .into(),
         );
     }
     Ok(())

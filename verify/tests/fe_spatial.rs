@@ -6,6 +6,7 @@
 //!   azimuth), on Irvine's elastic catenary at second order in 1/N;
 //! - the Hangprinter move: the energy balance with the reels' work (FE.7), the rest tensions of
 //!   the lumped lines to within the lines' weight, and the elastic cables' path as μ → 0;
+//! - reels driven by length on the implicit path, converging to DOPRI5 at second order;
 //! - what it does not run yet is refused by name.
 
 use cdpr_bench::core::model::{CableModel, PoseRule, SplitRule};
@@ -291,12 +292,10 @@ fn the_path_tends_to_the_elastic_cables_as_mu_goes_to_zero() {
     }
 }
 
-/// What the spatial FE cables do not run yet is refused by name: reels driven by length on the
-/// implicit path and the rigid stored cable before any work, a mesh beyond the dense statics at
-/// the start.
+/// What the spatial FE cables do not run yet is refused by name: the rigid stored cable before
+/// any work, a mesh beyond the dense statics at the start.
 #[test]
 fn what_is_not_built_is_refused_by_name() {
-    use cdpr_bench::core::scenario::ControllerKind;
     let refused = |s: Scenario, key: &str| {
         let e = cdpr_bench::prepare_spatial(&s)
             .err()
@@ -310,10 +309,6 @@ fn what_is_not_built_is_refused_by_name() {
             .unwrap_or_else(|| panic!("{key}: accepted"));
         assert!(e.contains(key), "{key}: {e}");
     };
-    let mut s = hangprinter(10, 970.0);
-    s.controller.kind = ControllerKind::Length;
-    s.simulation.integrator = cdpr_bench::core::scenario::IntegratorKind::Implicit;
-    refused(s, "simulation.integrator");
     refused(short(hangprinter(61, 970.0)), "model.elements");
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../examples/robots/hangprinter-lumped.toml");
@@ -451,5 +446,82 @@ fn reels_driven_by_length_pay_out_the_command() {
     assert!(
         (a - b).abs() < 0.05 * b,
         "static compensation: FE {a:e} m, elastic {b:e} m"
+    );
+}
+
+/// Reels driven by length on the implicit path (Du's form: the assembly's l_i rows read
+/// l_i'' = l̈0_i + (l̇0_i − l_i')/τ, τ = 1e-4 s, and the coloured differences take the loop's
+/// ∂R/∂q' with the rest), the Hangprinter move with static flex compensation by the closed
+/// form, which keeps every line taut (the QP's low pretension lets one go slack on the way,
+/// and the tension-only kink is not smooth for any step), 0.4 s, against DOPRI5 at rtol 1e-10:
+/// no pulley passes on FE cables, so the whole run is second order — the path gap and the
+/// energy balance's residual fall by 0.18–0.35 per halving of h from 1e-4 s (measured 0.25 and
+/// 0.25), the gap stays
+/// below 1e-6 m and the residual below 2e-6 J at the default step. The loop is stiff for
+/// DOPRI5 (its stability, not its tolerance, sets the step: rtol 1e-10 and 1e-5 take ~54 000
+/// steps alike), so the implicit path needs a tenth of its evaluations or fewer (measured
+/// 9 981 residuals against 372 374 right-hand sides).
+#[test]
+fn length_reels_run_on_the_implicit_path_at_second_order() {
+    use cdpr_bench::core::channel::Channel;
+    use cdpr_bench::core::robot::distribution::DistributionMethod;
+    use cdpr_bench::core::scenario::{ControllerKind, IntegratorKind};
+    let length = |step: Option<f64>| {
+        let mut s = short(hangprinter(10, 970.0));
+        s.controller.kind = ControllerKind::Length;
+        s.controller.distribution = DistributionMethod::ClosedForm;
+        match step {
+            Some(h) => {
+                s.simulation.integrator = IntegratorKind::Implicit;
+                s.simulation.step = h;
+            }
+            None => {
+                s.simulation.rtol = 1e-10;
+                s.simulation.atol = 1e-13;
+            }
+        }
+        s.validate().unwrap();
+        run(&s)
+    };
+    let reference = length(None);
+    let c = |r: &cdpr_bench::SpatialRun, ch| r.run.series.column(ch).unwrap();
+    let (x0, y0, z0) = (
+        c(&reference, Channel::X),
+        c(&reference, Channel::Y),
+        c(&reference, Channel::Z),
+    );
+    let runs: Vec<_> = [1e-4, 5e-5, 2.5e-5]
+        .iter()
+        .map(|&h| length(Some(h)))
+        .collect();
+    let gaps: Vec<f64> = runs
+        .iter()
+        .map(|r| {
+            let (x, y, z) = (c(r, Channel::X), c(r, Channel::Y), c(r, Channel::Z));
+            (0..x.len())
+                .map(|i| {
+                    ((x[i] - x0[i]).powi(2) + (y[i] - y0[i]).powi(2) + (z[i] - z0[i]).powi(2))
+                        .sqrt()
+                })
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    let audits: Vec<f64> = runs.iter().map(|r| r.metrics.energy_residual_max).collect();
+    println!("length reels, h = 1e-4, 5e-5, 2.5e-5 s: path gaps {gaps:?} m, audits {audits:?} J");
+    for k in 1..gaps.len() {
+        let (path, audit) = (gaps[k] / gaps[k - 1], audits[k] / audits[k - 1]);
+        assert!(
+            (0.18..=0.35).contains(&path) && (0.18..=0.35).contains(&audit),
+            "path gaps {gaps:?} m, energy residuals {audits:?} J"
+        );
+    }
+    assert!(
+        gaps[0] < 1e-6 && audits[0] < 2e-6,
+        "{gaps:?} m, {audits:?} J"
+    );
+    let (implicit, explicit) = (runs[0].run.stats.rhs_evals, reference.run.stats.rhs_evals);
+    assert!(
+        10 * implicit < explicit,
+        "{implicit} residuals against DOPRI5's {explicit} right-hand sides"
     );
 }

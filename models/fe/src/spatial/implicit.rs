@@ -95,6 +95,11 @@ impl SecondOrderForm for FeSpatial {
         }
     }
 
+    /// Driven by length, the assembly's l_i rows read l_i'' = the command (Du's form).
+    fn follows_driven_reels(&self) -> bool {
+        true
+    }
+
     fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: &[f64], r: &mut [f64]) {
         self.assemble(state, tensions);
         self.system.residual(qdd, r);
