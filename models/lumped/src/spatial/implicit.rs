@@ -2,8 +2,9 @@
 //! R = diag(m) q'' − F(q, q', T), F the forces of the right-hand side (a stored node's force
 //! projected on its reel line r_i, so its rows across the line read m q''_⊥ = 0 and it stays on
 //! the line; a locked reel end has none, so its rows read m q'' = 0). The iteration matrix is
-//! diag(m) plus the springs' analytic tangent stiffness for undamped cables, coloured central
-//! differences for damped ones; a reel driven by length adds its velocity loop's ∂R/∂q' on the
+//! diag(m) plus the springs' analytic tangent stiffness and damping ([`super::tangent`]),
+//! coloured central differences where a straddling spring's end sits at its pulley and as the
+//! tests' reference; a reel driven by length adds its velocity loop's ∂R/∂q' on the
 //! stored nodes ([`super::reel`]). Its pattern is the chains': each node's 3 × 3 block couples only to its two
 //! neighbours along its cable (the straddling spring's ends are neighbours too), the effector to
 //! the last node of every cable — the star of m arms meeting at the effector. The pattern does
@@ -13,7 +14,7 @@ use super::LumpedSpatial;
 use cdpr_core::model::CableModel;
 use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
 use cdpr_numerics::differences::{CBRT_EPSILON, ColouredDifferences};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Matrix3;
 
 /// The refresh rule's price of an analytic matrix, in Newton iterations (the planar lumped
 /// model's, measured there: the time is flat within ±1 % from 32 to 128).
@@ -31,7 +32,14 @@ impl LumpedSpatial {
     /// `c`) of the block coupling node `row` to node `col` of `cable` (equal or adjacent; the
     /// effector is node N). Per cable and node j: its own block, then (j, j + 1), then
     /// (j + 1, j), 9 entries each; the effector's own block last.
-    fn pattern_index(&self, cable: usize, row: usize, col: usize, r: usize, c: usize) -> usize {
+    pub(super) fn pattern_index(
+        &self,
+        cable: usize,
+        row: usize,
+        col: usize,
+        r: usize,
+        c: usize,
+    ) -> usize {
         let n = self.elements;
         let slot = |j: usize| 27 * (cable * n + j);
         let within = 3 * r + c;
@@ -50,7 +58,7 @@ impl LumpedSpatial {
     }
 
     /// diag(m) in the order of the iteration pattern.
-    fn mass_matrix_into(&self, values: &mut [f64]) {
+    pub(super) fn mass_matrix_into(&self, values: &mut [f64]) {
         let n = self.elements;
         values.fill(0.0);
         for cable in 0..self.robot().cables() {
@@ -67,7 +75,7 @@ impl LumpedSpatial {
 
     /// The projection of node `j`'s force rows: r_i r_iᵀ for a stored node, 0 for one on a
     /// locked reel, I for a free node.
-    fn row_projection(&self, cable: usize, j: usize) -> Matrix3<f64> {
+    pub(super) fn row_projection(&self, cable: usize, j: usize) -> Matrix3<f64> {
         if j < self.stored[cable] && self.drive != super::reel::ReelDrive::Tension {
             Matrix3::zeros()
         } else if j < self.stored[cable] {
@@ -76,70 +84,6 @@ impl LumpedSpatial {
         } else {
             Matrix3::identity()
         }
-    }
-
-    /// S = diag(m) − c_q ∂F/∂q for undamped springs (the planar model's blocks in 3-D: a taut
-    /// chord spring's K = k u uᵀ + (T/λ)(I − u uᵀ); the straddling spring pulls each end toward
-    /// the pulley, ∂F_a/∂a = −k u_a u_aᵀ − (T/|A − a|)(I − u_a u_aᵀ), ∂F_a/∂b = −k u_a u_bᵀ),
-    /// each block's rows projected as the node's forces are. False where a straddling end sits
-    /// exactly at its pulley.
-    pub(super) fn tangent_matrix(&self, state: &[f64], c_q: f64, values: &mut [f64]) -> bool {
-        let n = self.elements;
-        self.mass_matrix_into(values);
-        let (k, l0) = (self.stiffness, self.segment);
-        let identity = Matrix3::identity();
-        for cable in 0..self.robot().cables() {
-            let stored = self.stored[cable];
-            for j in 0..n {
-                let (a, b) = (self.node(state, cable, j), self.node(state, cable, j + 1));
-                let blocks = if j + 1 == stored {
-                    let pulley = self.pulley(cable);
-                    let (da, db) = (pulley - a, pulley - b);
-                    let (la, lb) = (da.norm(), db.norm());
-                    if la == 0.0 || lb == 0.0 {
-                        return false;
-                    }
-                    let stretch = la + lb - l0;
-                    if stretch <= 0.0 {
-                        continue;
-                    }
-                    let t = k * stretch;
-                    let (ua, ub): (Vector3<f64>, Vector3<f64>) = (da / la, db / lb);
-                    [
-                        -ua * ua.transpose() * k - (identity - ua * ua.transpose()) * (t / la),
-                        -ua * ub.transpose() * k,
-                        -ub * ua.transpose() * k,
-                        -ub * ub.transpose() * k - (identity - ub * ub.transpose()) * (t / lb),
-                    ]
-                } else {
-                    let d = b - a;
-                    let length = d.norm();
-                    let stretch = length - l0;
-                    if stretch <= 0.0 {
-                        continue;
-                    }
-                    let u = d / length;
-                    let along = u * u.transpose();
-                    let tangent = along * k + (identity - along) * (k * stretch / length);
-                    [-tangent, tangent, tangent, -tangent]
-                };
-                let pairs = [(j, j), (j, j + 1), (j + 1, j), (j + 1, j + 1)];
-                for (block, (row, col)) in blocks.iter().zip(pairs) {
-                    let projected = if row < n {
-                        self.row_projection(cable, row) * block
-                    } else {
-                        *block
-                    };
-                    for r in 0..3 {
-                        for c in 0..3 {
-                            values[self.pattern_index(cable, row, col, r, c)] -=
-                                c_q * projected[(r, c)];
-                        }
-                    }
-                }
-            }
-        }
-        true
     }
 
     fn residual_into(&mut self, state: &[f64], qdd: &[f64], tensions: &[f64], r: &mut [f64]) {
@@ -185,7 +129,7 @@ impl LumpedSpatial {
     }
 
     /// S by coloured central differences of the residual (any damping).
-    pub(super) fn differenced_matrix(
+    pub fn differenced_matrix(
         &mut self,
         state: &[f64],
         qdd: &[f64],
@@ -278,8 +222,9 @@ impl SecondOrderForm for LumpedSpatial {
         true
     }
 
-    /// As the planar model's: a quarter of the smallest |λ − l0| of the springs at a node, and
-    /// ε^(1/3) of the distance to the pulley at the straddling spring's ends.
+    /// As the planar model's: a quarter of the smallest |λ − l0| of the springs at a node (and of
+    /// T/k0 for damped springs, whose clip at T = 0 moves with λ̇), and ε^(1/3) of the distance
+    /// to the pulley at the straddling spring's ends.
     fn smooth_reach(&self, state: &[f64], out: &mut [f64]) {
         let n = self.elements;
         out.fill(f64::INFINITY);
@@ -288,6 +233,12 @@ impl SecondOrderForm for LumpedSpatial {
             for j in 0..n {
                 let length = self.spring_length(state, cable, j);
                 let mut limit = 0.25 * (length - self.segment).abs();
+                if self.damping != 0.0 {
+                    // The damping's clip, T = max(k0 s + c λ̇, 0), lies T/k0 away.
+                    let (_, rate, _, _) = self.spring(state, cable, j);
+                    let pull = self.stiffness * (length - self.segment) + self.damping * rate;
+                    limit = limit.min(0.25 * (pull / self.stiffness).abs());
+                }
                 if j + 1 == r {
                     let pulley = self.pulley(cable);
                     for node in [j, j + 1] {
@@ -305,8 +256,8 @@ impl SecondOrderForm for LumpedSpatial {
         }
     }
 
-    /// Analytic for undamped springs, coloured central differences otherwise (or where a
-    /// straddling spring's end sits exactly at its pulley).
+    /// Analytic ([`super::tangent`]), or coloured central differences where a straddling
+    /// spring's end sits exactly at its pulley.
     fn iteration_matrix(
         &mut self,
         state: &[f64],
@@ -316,7 +267,7 @@ impl SecondOrderForm for LumpedSpatial {
         c_q: f64,
         values: &mut [f64],
     ) -> MatrixCost {
-        if self.damping == 0.0 && self.tangent_matrix(state, c_q, values) {
+        if self.tangent_matrix(state, c_v, c_q, values) {
             self.add_reel_loop(c_v, values);
             return MatrixCost::without_residuals(TANGENT_REFRESH_PRICE);
         }

@@ -29,6 +29,7 @@ mod pulley;
 mod reel;
 mod springs;
 mod statics;
+mod tangent;
 
 use crate::spring_tension;
 use cdpr_core::modal_layout::ModalLayout;
