@@ -12,6 +12,7 @@
 //! Errors are printed for a person and give a non-zero exit; a failed run keeps its output.
 
 mod control;
+mod cost;
 mod csv_stream;
 mod distribution;
 mod figures;

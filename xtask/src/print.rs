@@ -171,8 +171,9 @@ struct PrintMetricsFile<'a> {
     #[serde(flatten)]
     contour: BTreeMap<String, f64>,
     samples: usize,
-    steps: u64,
-    rhs_evaluations: u64,
+    /// The run's cost.
+    #[serde(flatten)]
+    cost: crate::cost::RunCost,
     wall_s: f64,
     units: BTreeMap<&'static str, &'static str>,
 }
@@ -401,8 +402,7 @@ fn write_metrics(
             t_reached: run.map_or(0.0, |r| r.t_reached),
             contour: ended.contour.as_ref().map(flat).unwrap_or_default(),
             samples: run.map_or(0, |r| r.series.len()),
-            steps: run.map_or(0, |r| r.stats.steps_accepted),
-            rhs_evaluations: run.map_or(0, |r| r.stats.rhs_evals),
+            cost: run.map(|r| (&r.stats).into()).unwrap_or_default(),
             wall_s: ended.wall_s,
             units: [
                 ("print_time_s", "s"),

@@ -30,9 +30,9 @@ struct SpatialMetricsFile<'a> {
     provenance: &'a Provenance,
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     metrics: Option<&'a SpatialMetrics>,
-    /// Accepted steps and right-hand-side evaluations: the run's cost.
-    steps: u64,
-    rhs_evaluations: u64,
+    /// The run's cost.
+    #[serde(flatten)]
+    cost: crate::cost::RunCost,
     units: BTreeMap<&'static str, &'static str>,
 }
 
@@ -156,8 +156,7 @@ fn write_metrics(
             t_reached: done.map_or(0.0, |d| d.run.t_reached),
             provenance,
             metrics: done.map(|d| &d.metrics),
-            steps: done.map_or(0, |d| d.run.stats.steps_accepted),
-            rhs_evaluations: done.map_or(0, |d| d.run.stats.rhs_evals),
+            cost: done.map(|d| (&d.run.stats).into()).unwrap_or_default(),
             units: units.collect(),
         },
     )

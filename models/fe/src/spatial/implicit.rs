@@ -1,8 +1,9 @@
 //! The spatial FE robot's second-order form R = M(q) q'' − F(q, q', T) for the implicit path
 //! (MODELS.md FE.9.3): R from the star's assembly ([`super::star::StarSystem::residual`]), the
-//! iteration matrix by coloured central differences of R over the star's pattern
-//! ([`ColouredDifferences`]), each position step kept within a quarter of the stretch of the
-//! elements it moves so that no probe reaches the tension-only kink.
+//! iteration matrix element by element ([`super::blocks`]), or by coloured central differences
+//! of R over the star's pattern ([`ColouredDifferences`]) when the reels prescribe the lengths;
+//! each position step kept within a quarter of the stretch of the elements it moves so that no
+//! probe reaches the tension-only kink.
 
 use super::FeSpatial;
 use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
@@ -105,7 +106,35 @@ impl SecondOrderForm for FeSpatial {
         self.system.residual(qdd, r);
     }
 
+    /// Element by element ([`super::blocks`]) under tension reels; coloured differences of
+    /// the residual when the reels prescribe the lengths (Du's form rewrites the l rows, which
+    /// the element kernel does not).
     fn iteration_matrix(
+        &mut self,
+        state: &[f64],
+        qdd: &[f64],
+        tensions: &[f64],
+        c_v: f64,
+        c_q: f64,
+        values: &mut [f64],
+    ) -> MatrixCost {
+        if self.length_driven {
+            return self.differenced_matrix(state, qdd, tensions, c_v, c_q, values);
+        }
+        self.block_matrix(state, qdd, [c_q, c_v, 1.0], values);
+        // No full residual: per block one base and 7 × (1 + 2 + 2) kernel probes, the kernels
+        // of about 36 residual sweeps, which is the refresh rule's price.
+        MatrixCost::without_residuals(BLOCK_MATRIX_PRICE)
+    }
+}
+
+/// The refresh rule's price of an element-by-element matrix, in residual sweeps.
+const BLOCK_MATRIX_PRICE: u64 = 36;
+
+impl FeSpatial {
+    /// S by coloured central differences of the whole residual (the element-by-element
+    /// matrix's reference in the tests).
+    pub fn differenced_matrix(
         &mut self,
         state: &[f64],
         qdd: &[f64],

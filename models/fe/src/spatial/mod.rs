@@ -9,6 +9,7 @@
 //! solved on the star of arms in O(N m) ([`star`]); the implicit path's form is [`implicit`].
 //! The stored cable is elastic (FE.1.3's reference variant); the rigid variant is planar only.
 
+mod blocks;
 mod implicit;
 mod star;
 mod statics;
@@ -42,8 +43,12 @@ pub struct FeSpatial {
     /// Accelerations of the free nodes (cable-major) and of (l_i, ρ_i), per solve.
     node_accelerations: Vec<Vector3<f64>>,
     border_accelerations: Vec<[f64; 2]>,
-    /// The implicit path's coloured differences (built at the first iteration matrix).
+    /// The implicit path's coloured differences (built at the first iteration matrix they
+    /// make: reels driven by length, and the tests' reference).
     differences: Option<cdpr_numerics::differences::ColouredDifferences>,
+    /// Where the element blocks' entries go in the iteration pattern (built at the first
+    /// element-by-element matrix, [`blocks`]).
+    block_slots: Vec<usize>,
     /// Reels driven by length (the scenario's `length` controller): the free lengths l_i are
     /// prescribed (MODELS.md FE.5.6, Du's form), the stored cable is on the reel and not
     /// modelled; `drive` holds the commanded (l̇0_i, l̈0_i) from the last
@@ -134,6 +139,7 @@ impl FeSpatial {
             node_accelerations: vec![Vector3::zeros(); m * (n - 1)],
             border_accelerations: vec![[0.0; 2]; m],
             differences: None,
+            block_slots: Vec::new(),
             length_driven: false,
             drive: None,
             prescribing: vec![0.0; m],
