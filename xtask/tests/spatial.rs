@@ -208,8 +208,8 @@ fn flex_error_writes_a_consistent_record() {
 }
 
 /// Refused before any file: a reference the box cannot follow (named with time, pose, cable),
-/// a robot described for its statics only (no move), FE cables on length reels on the implicit
-/// path, and lumped lines too short for the move or reeled into the workspace.
+/// a robot described for its statics only (no move), and lumped lines too short for the move
+/// or reeled into the workspace.
 #[test]
 fn spatial_runs_are_refused_before_any_file() {
     let dir = TempDir::new("spatial-refusals");
@@ -225,13 +225,6 @@ fn spatial_runs_are_refused_before_any_file() {
 
     for (file, text, expected) in [
         ("fast.toml", fast, "wrench-feasible workspace at t ="),
-        (
-            "fe.toml",
-            long(model("kind = \"fe\""))
-                .replace("\"computed-torque\"", "\"length\"")
-                .replace("[simulation]", "[simulation]\nintegrator = \"implicit\""),
-            "simulation.integrator",
-        ),
         (
             "short.toml",
             model("kind = \"lumped\""),

@@ -28,9 +28,32 @@ pub(super) struct StepStart<const D: usize> {
     /// iterations of a step evaluate at one time, so the commanded lengths' rates (three
     /// distributions) are computed once per time.
     pub(super) driven_at: Option<f64>,
+    /// The time of the last audit rates (reel power, dissipation) at the implicit path's step
+    /// end, and their values: the step's end, the tail's rate there and the next step's start
+    /// all ask at one state, and a damped model's dissipation sums every element. Any other
+    /// evaluation (the right-hand side, which a restart calls) forgets them.
+    pub(super) audited_at: Option<f64>,
+    audited: (f64, f64),
 }
 
 impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
+    /// The reels' power Σ T_i v_reel,i (or a driven reel's) and the model's dissipation [W] at
+    /// t and `model_state` under `cmd`, the command there: remembered from the last call at t
+    /// (see [`StepStart::audited_at`]).
+    fn audits_at(&mut self, t: f64, model_state: &[f64], cmd: &Command) -> (f64, f64) {
+        if self.step_start.audited_at == Some(t) {
+            return self.step_start.audited;
+        }
+        let reel = self.model.reel_speeds(model_state);
+        let audits = (
+            self.model.reel_power(model_state, &cmd.tensions, &reel),
+            self.model.dissipation(model_state),
+        );
+        self.step_start.audited_at = Some(t);
+        self.step_start.audited = audits;
+        audits
+    }
+
     /// Hands the model the commanded lengths' rates at t when its reels are driven by length
     /// (as the right-hand side does), unless this step already did at t.
     fn drive_reels_at(&mut self, t: f64) {
@@ -152,15 +175,14 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         let effector = self.model.effector(model_state);
         let reference = self.reference(t);
         let cmd = self.command_with(t, &reference, &effector, &y[n..n + c]);
-        let reel = self.model.reel_speeds(model_state);
-        let dissipation = self.model.dissipation(model_state);
+        let (power, dissipation) = self.audits_at(t, model_state, &cmd);
         let s = &mut self.step_start;
         s.h = h;
         s.reference = reference;
         s.effector = effector;
         s.states[..c].copy_from_slice(&y[n..n + c]);
         s.saturated = cmd.saturated;
-        s.power = self.model.reel_power(model_state, &cmd.tensions, &reel);
+        s.power = power;
         s.dissipation = dissipation;
         s.work = y[n + c];
         s.dissipated = y[n + c + 1];
@@ -235,11 +257,14 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
     fn tail_rate(&mut self, t: f64, y: &[f64], out: &mut [f64]) {
         self.drive_reels_at(t);
         let n = self.model_len();
+        let c = self.controller_len();
         let effector = self.model.effector(&y[..n]);
         let reference = self.reference(t);
-        let cmd = self.command_with(t, &reference, &effector, &y[n..n + self.controller_len()]);
-        let reel = self.model.reel_speeds(&y[..n]);
-        self.controller_and_audit_rates(y, (&reference, &effector), (&cmd, &reel), out);
+        let cmd = self.command_with(t, &reference, &effector, &y[n..n + c]);
+        let (rates, audits) = out.split_at_mut(c);
+        self.controller
+            .state_rate(&reference, &effector, &y[n..n + c], cmd.saturated, rates);
+        (audits[0], audits[1]) = self.audits_at(t, &y[..n], &cmd);
     }
 
     /// The model's and the controller's states; the energy audits stay out of the norm.
@@ -262,9 +287,8 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         let mut states = [0.0; MAX_CONTROLLER_STATES];
         let cmd = self.step_end_command(t, &effector, &mut states);
         y[n..n + c].copy_from_slice(&states[..c]);
-        let reel = self.model.reel_speeds(&y[..n]);
-        let power = self.model.reel_power(&y[..n], &cmd.tensions, &reel);
-        let dissipation = self.model.dissipation(&y[..n]);
+        self.step_start.audited_at = None;
+        let (power, dissipation) = self.audits_at(t, &y[..n], &cmd);
         let s = &self.step_start;
         y[n + c] = s.work + 0.5 * s.h * (s.power + power);
         y[n + c + 1] = s.dissipated + 0.5 * s.h * (s.dissipation + dissipation);

@@ -313,6 +313,8 @@ impl<M: CableModel<D>, const D: usize> OdeSystem for ClosedLoop<M, D> {
     }
 
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        // A state the implicit path's audits were not taken at (a restart starts here).
+        self.step_start.audited_at = None;
         let n = self.model_len();
         let effector = self.model.effector(&y[..n]);
         let reference = self.reference(t);
