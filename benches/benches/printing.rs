@@ -2,7 +2,10 @@
 //! per second), and the cube's first layer (≈ 44 s of printing at 3 000 mm/s²) printed by the
 //! Hangprinter-like robot with elastic cables under computed-torque — the wrench-feasibility
 //! check every millisecond and the run (sampled at the end only: integration, reference and
-//! controller). Steps and RHS evaluations of the run are printed once.
+//! controller), and the same layer on the massive lines (lumped N = 20, FE N = 10; the printer
+//! example's damped line) on the implicit path, sampled every millisecond with the contour
+//! error measured, as `cargo xtask print` runs it but for the files. Steps, RHS (residual)
+//! evaluations and iteration matrices of each run are printed once.
 
 use cdpr_bench::core::closed_loop::{ClosedLoop, Path as LoopPath};
 use cdpr_bench::core::runner::simulate;
@@ -80,5 +83,49 @@ fn cube_first_layer(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, planning, cube_first_layer);
+/// The printer example on massive lines of `kind` with `elements` per line, on the implicit path
+/// (its lines long enough for the build volume's corners).
+fn on_massive_lines(kind: &str, elements: usize) -> Scenario {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/printing/hangprinter.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let text = format!("{text}\n[model]\nkind = \"{kind}\"\nelements = {elements}\n");
+    let mut s = Scenario::from_toml_str(&text).unwrap();
+    s.cable.modelled_length = 3.2;
+    s.simulation.integrator = cdpr_bench::core::scenario::IntegratorKind::Implicit;
+    s
+}
+
+fn cube_first_layer_massive(c: &mut Criterion) {
+    let mut group = c.benchmark_group("printing/cube_layer1_hangprinter");
+    group.sample_size(10);
+    let text = std::fs::read_to_string(data("cube.gcode")).unwrap();
+    for (kind, elements) in [("lumped", 20), ("fe", 10)] {
+        let scenario = on_massive_lines(kind, elements);
+        let print = cdpr_bench::prepare_print(&scenario, &text, Some(1..=1)).unwrap();
+        let go = || {
+            let mut quiet = |_: f64| {};
+            let mut observer = cdpr_bench::core::runner::Observer::progress(&mut quiet);
+            cdpr_bench::simulate_print(&scenario, &print, &mut observer).unwrap()
+        };
+        let once = go();
+        println!(
+            "cube layer 1, {kind} N = {elements}, computed-torque, implicit: {} steps, {} residuals, {} matrices, contour max {:.1} µm",
+            once.run.stats.steps_accepted,
+            once.run.stats.rhs_evals,
+            once.run.stats.jacobian_evals,
+            once.contour.printing.max * 1e6
+        );
+        group.bench_function(
+            format!("{kind}{elements}_computed_torque_implicit_with_contour"),
+            |b| b.iter(|| black_box(go().run.t_reached)),
+        );
+    }
+}
+
+criterion_group!(
+    benches,
+    planning,
+    cube_first_layer,
+    cube_first_layer_massive
+);
 criterion_main!(benches);
