@@ -224,6 +224,19 @@ fn run(s: &Scenario) -> cdpr_bench::SpatialRun {
     cdpr_bench::simulate_spatial(s, &mut Observer::progress(&mut quiet)).unwrap()
 }
 
+/// Largest distance between the effector positions of two runs sampled alike [m].
+fn path_gap(a: &cdpr_bench::SpatialRun, b: &cdpr_bench::SpatialRun) -> f64 {
+    use cdpr_bench::core::channel::Channel;
+    let path = |r: &cdpr_bench::SpatialRun| {
+        let c = |ch| r.run.series.column(ch).unwrap();
+        (c(Channel::X), c(Channel::Y), c(Channel::Z))
+    };
+    let ((x, y, z), (x0, y0, z0)) = (path(a), path(b));
+    (0..x.len())
+        .map(|i| ((x[i] - x0[i]).powi(2) + (y[i] - y0[i]).powi(2) + (z[i] - z0[i]).powi(2)).sqrt())
+        .fold(0.0, f64::max)
+}
+
 fn short(mut s: Scenario) -> Scenario {
     s.simulation.t_final = 0.4;
     s.validate().unwrap();
@@ -267,24 +280,9 @@ fn the_path_tends_to_the_elastic_cables_as_mu_goes_to_zero() {
         cdpr_bench::with_model_kind(&hangprinter(10, 970.0), cdpr_bench::ModelKind::Elastic)
             .unwrap(),
     ));
-    let path = |r: &cdpr_bench::SpatialRun| {
-        use cdpr_bench::core::channel::Channel;
-        let s = &r.run.series;
-        let c = |ch| s.column(ch).unwrap();
-        (c(Channel::X), c(Channel::Y), c(Channel::Z))
-    };
-    let (ex, ey, ez) = path(&elastic);
     let gaps: Vec<f64> = [970.0, 485.0, 242.5]
         .iter()
-        .map(|&rho| {
-            let (x, y, z) = path(&run(&short(hangprinter(10, rho))));
-            (0..x.len())
-                .map(|i| {
-                    ((x[i] - ex[i]).powi(2) + (y[i] - ey[i]).powi(2) + (z[i] - ez[i]).powi(2))
-                        .sqrt()
-                })
-                .fold(0.0, f64::max)
-        })
+        .map(|&rho| path_gap(&run(&short(hangprinter(10, rho))), &elastic))
         .collect();
     for k in 1..gaps.len() {
         let ratio = gaps[k] / gaps[k - 1];
@@ -319,6 +317,32 @@ fn what_is_not_built_is_refused_by_name() {
     refused(Scenario::from_toml_str(&rigid).unwrap(), "model.fe_stored");
 }
 
+/// Pseudo-random numbers in [−scale, scale) from a seed (a linear congruential sequence).
+struct Jiggle(f64);
+
+impl Jiggle {
+    fn next(&mut self, scale: f64) -> f64 {
+        self.0 = (self.0 * 9301.0 + 49297.0) % 233280.0;
+        scale * (self.0 / 116640.0 - 1.0)
+    }
+}
+
+/// The Hangprinter's rest near (0.1, 0.05, 0.02) m on FE cables of `elements` elements, its
+/// nodes moved by up to 2 mm and every rate (nodes, l_i, ρ_i) set within ±`speed`, and the
+/// sequence that did it, to go on.
+fn shaken_rest(elements: usize, seed: u64, speed: f64) -> (FeSpatial, Vec<f64>, Jiggle) {
+    let (model, mut y) = rest(elements, 970.0, [0.1, 0.05, 0.02]);
+    let np = model.positions_len();
+    let mut jiggle = Jiggle(seed as f64 * 0.618);
+    for v in &mut y[..np - 8] {
+        *v += jiggle.next(2e-3);
+    }
+    for v in &mut y[np..] {
+        *v = jiggle.next(speed);
+    }
+    (model, y, jiggle)
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(16))]
 
@@ -330,20 +354,8 @@ proptest! {
         elements in 2usize..12, seed in 0u64..1000,
     ) {
         use cdpr_bench::core::second_order::SecondOrderForm;
-        let (mut model, rest) = rest(elements, 970.0, [0.1, 0.05, 0.02]);
+        let (mut model, y, _) = shaken_rest(elements, seed, 0.3);
         let np = model.positions_len();
-        let mut state = seed as f64 * 0.618;
-        let mut jiggle = |scale: f64| {
-            state = (state * 9301.0 + 49297.0) % 233280.0;
-            scale * (state / 116640.0 - 1.0)
-        };
-        let mut y = rest.clone();
-        for v in &mut y[..np - 8] {
-            *v += jiggle(2e-3);
-        }
-        for v in &mut y[np..] {
-            *v = jiggle(0.3);
-        }
         let tensions = [14.0, 13.0, 11.0, 12.5];
         let mut qdd = vec![0.0; np];
         prop_assert!(model.accelerations(&y, &tensions, &mut qdd));
@@ -373,25 +385,13 @@ proptest! {
         elements in 1usize..12, damped in any::<bool>(), seed in 0u64..1000, h in 1e-5f64..1e-3,
     ) {
         use cdpr_bench::core::second_order::SecondOrderForm;
-        let (mut model, rest) = rest(elements, 970.0, [0.1, 0.05, 0.02]);
+        let (mut model, y, mut jiggle) = shaken_rest(elements, seed, 0.05);
         if damped {
             model.axial_damping = 8.5;
         }
         let np = model.positions_len();
-        let mut state = seed as f64 * 0.618;
-        let mut jiggle = |scale: f64| {
-            state = (state * 9301.0 + 49297.0) % 233280.0;
-            scale * (state / 116640.0 - 1.0)
-        };
-        let mut y = rest.clone();
-        for v in &mut y[..np - 8] {
-            *v += jiggle(2e-3);
-        }
-        for v in &mut y[np..] {
-            *v = jiggle(0.05);
-        }
         let tensions = [14.0, 13.0, 11.0, 12.5];
-        let qdd: Vec<f64> = (0..np).map(|_| jiggle(1.0)).collect();
+        let qdd: Vec<f64> = (0..np).map(|_| jiggle.next(1.0)).collect();
         let (c_v, c_q) = (0.6 * h, 0.3 * h * h);
         let len = model.iteration_pattern().len();
         let (mut blocks, mut differenced, mut masses) = (vec![0.0; len], vec![0.0; len], vec![0.0; len]);
@@ -416,29 +416,18 @@ proptest! {
 /// path error) at the default step.
 #[test]
 fn the_implicit_path_converges_at_second_order() {
-    use cdpr_bench::core::channel::Channel;
     use cdpr_bench::core::scenario::IntegratorKind;
-    let path = |r: &cdpr_bench::SpatialRun| {
-        let c = |ch| r.run.series.column(ch).unwrap();
-        (c(Channel::X), c(Channel::Y), c(Channel::Z))
-    };
     let mut reference = short(hangprinter(10, 970.0));
     reference.simulation.rtol = 1e-10;
     reference.simulation.atol = 1e-13;
-    let (x0, y0, z0) = path(&run(&reference));
+    let reference = run(&reference);
     let gaps: Vec<f64> = [1e-4, 5e-5, 2.5e-5]
         .iter()
         .map(|&h| {
             let mut s = short(hangprinter(10, 970.0));
             s.simulation.integrator = IntegratorKind::Implicit;
             s.simulation.step = h;
-            let (x, y, z) = path(&run(&s));
-            (0..x.len())
-                .map(|i| {
-                    ((x[i] - x0[i]).powi(2) + (y[i] - y0[i]).powi(2) + (z[i] - z0[i]).powi(2))
-                        .sqrt()
-                })
-                .fold(0.0, f64::max)
+            path_gap(&run(&s), &reference)
         })
         .collect();
     println!("implicit against DOPRI5 at h = 1e-4, 5e-5, 2.5e-5 s: {gaps:?} m");
@@ -515,7 +504,6 @@ fn reels_driven_by_length_pay_out_the_command() {
 /// 9 981 residuals against 372 374 right-hand sides).
 #[test]
 fn length_reels_run_on_the_implicit_path_at_second_order() {
-    use cdpr_bench::core::channel::Channel;
     use cdpr_bench::core::robot::distribution::DistributionMethod;
     use cdpr_bench::core::scenario::{ControllerKind, IntegratorKind};
     let length = |step: Option<f64>| {
@@ -536,28 +524,11 @@ fn length_reels_run_on_the_implicit_path_at_second_order() {
         run(&s)
     };
     let reference = length(None);
-    let c = |r: &cdpr_bench::SpatialRun, ch| r.run.series.column(ch).unwrap();
-    let (x0, y0, z0) = (
-        c(&reference, Channel::X),
-        c(&reference, Channel::Y),
-        c(&reference, Channel::Z),
-    );
     let runs: Vec<_> = [1e-4, 5e-5, 2.5e-5]
         .iter()
         .map(|&h| length(Some(h)))
         .collect();
-    let gaps: Vec<f64> = runs
-        .iter()
-        .map(|r| {
-            let (x, y, z) = (c(r, Channel::X), c(r, Channel::Y), c(r, Channel::Z));
-            (0..x.len())
-                .map(|i| {
-                    ((x[i] - x0[i]).powi(2) + (y[i] - y0[i]).powi(2) + (z[i] - z0[i]).powi(2))
-                        .sqrt()
-                })
-                .fold(0.0, f64::max)
-        })
-        .collect();
+    let gaps: Vec<f64> = runs.iter().map(|r| path_gap(r, &reference)).collect();
     let audits: Vec<f64> = runs.iter().map(|r| r.metrics.energy_residual_max).collect();
     println!("length reels, h = 1e-4, 5e-5, 2.5e-5 s: path gaps {gaps:?} m, audits {audits:?} J");
     for k in 1..gaps.len() {
