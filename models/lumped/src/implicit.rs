@@ -12,7 +12,7 @@
 use crate::Lumped;
 use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
 use cdpr_numerics::differences::{CBRT_EPSILON, ColouredDifferences};
-use nalgebra::Vector2;
+use nalgebra::{Matrix2, Vector2};
 
 /// Buffers of the second-order form (allocated once per model).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -86,7 +86,17 @@ impl Lumped {
     /// slack spring adds nothing; a stored node's z row is its mass alone (MODELS.md §4: the
     /// constraint holds it on z = 0). False (values unusable) where a straddling end sits exactly
     /// at its pulley (no direction there).
-    pub(crate) fn tangent_matrix(&self, state: &[f64], c_q: f64, values: &mut [f64]) -> bool {
+    ///
+    /// With `damping` c = C/l0 ≠ 0 (the implicit path's damped springs; the statics pass 0 and
+    /// keep the undamped blocks to the bit), T = k s + c λ̇ and the blocks gain the rate's
+    /// position dependence and c_v ∂F/∂q' ([`damped_blocks`]).
+    pub(crate) fn tangent_matrix(
+        &self,
+        state: &[f64],
+        (c_v, c_q): (f64, f64),
+        damping: f64,
+        values: &mut [f64],
+    ) -> bool {
         let n = self.elements;
         self.mass_matrix_into(values);
         let (k, l0) = (self.stiffness, self.segment);
@@ -96,6 +106,22 @@ impl Lumped {
             let stored = self.stored[cable];
             for j in 0..n {
                 let (a, b) = (self.node(state, cable, j), self.node(state, cable, j + 1));
+                if damping != 0.0 {
+                    let ends = [j, j + 1].map(|k| {
+                        (
+                            self.node(state, cable, k),
+                            self.node_velocity(state, cable, k),
+                        )
+                    });
+                    let pulley = (j + 1 == stored).then(|| self.pulley(cable));
+                    let blocks = match damped_blocks(ends, pulley, (k, l0, damping)) {
+                        Ok(Some(blocks)) => blocks,
+                        Ok(None) => continue,
+                        Err(AtPulley) => return false,
+                    };
+                    self.add_blocks(cable, j, &blocks, (c_v, c_q), values);
+                    continue;
+                }
                 // ∂F_a/∂a, ∂F_a/∂b, ∂F_b/∂a, ∂F_b/∂b.
                 let blocks = if j + 1 == stored {
                     let pulley = self.pulley(cable);
@@ -148,6 +174,33 @@ impl Lumped {
             }
         }
         true
+    }
+
+    /// Subtracts c_q times the position blocks and c_v times the rate blocks of spring j of
+    /// `cable` from S, a stored node's z row left to its mass.
+    fn add_blocks(
+        &self,
+        cable: usize,
+        j: usize,
+        blocks: &Blocks,
+        (c_v, c_q): (f64, f64),
+        values: &mut [f64],
+    ) {
+        let stored = self.stored[cable];
+        for (k, (row, col)) in [(j, j), (j, j + 1), (j + 1, j), (j + 1, j + 1)]
+            .into_iter()
+            .enumerate()
+        {
+            for r in 0..2 {
+                if r == 1 && row < stored {
+                    continue;
+                }
+                for c in 0..2 {
+                    values[self.pattern_index(cable, row, col, r, c)] -=
+                        c_q * blocks.position[k][(r, c)] + c_v * blocks.rate[k][(r, c)];
+                }
+            }
+        }
     }
 
     fn residual_into(&mut self, state: &[f64], qdd: &[f64], tensions: &[f64], r: &mut [f64]) {
@@ -244,6 +297,14 @@ impl SecondOrderForm for Lumped {
             for j in 0..n {
                 let length = self.spring_length(state, cable, j);
                 let mut limit = 0.25 * (length - self.segment).abs();
+                if self.damping != 0.0 {
+                    // The damping's clip, T = max(k s + c λ̇, 0), lies T/k away (s at rest).
+                    let (_, rate, _, _) = self.spring(state, cable, j);
+                    if rate != 0.0 {
+                        let pull = self.stiffness * (length - self.segment) + self.damping * rate;
+                        limit = limit.min(0.25 * (pull / self.stiffness).abs());
+                    }
+                }
                 if j + 1 == r {
                     let pulley = self.pulley(cable);
                     for node in [j, j + 1] {
@@ -260,9 +321,9 @@ impl SecondOrderForm for Lumped {
         }
     }
 
-    /// Analytic for undamped springs (the paper's run), whose forces depend on the positions
-    /// alone ([`Lumped::tangent_matrix`]); coloured central differences of the residual
-    /// otherwise, or where a straddling spring's end sits exactly at its pulley.
+    /// Analytic ([`Lumped::tangent_matrix`], damped springs' rate terms included); coloured
+    /// central differences of the residual where a straddling spring's end sits exactly at its
+    /// pulley.
     fn iteration_matrix(
         &mut self,
         state: &[f64],
@@ -272,7 +333,7 @@ impl SecondOrderForm for Lumped {
         c_q: f64,
         values: &mut [f64],
     ) -> MatrixCost {
-        if self.damping == 0.0 && self.tangent_matrix(state, c_q, values) {
+        if self.tangent_matrix(state, (c_v, c_q), self.damping, values) {
             return MatrixCost::without_residuals(TANGENT_REFRESH_PRICE);
         }
         self.differenced_matrix(state, qdd, tensions, c_v, c_q, values)
@@ -314,6 +375,86 @@ impl Lumped {
         self.implicit.differences = Some(differences);
         MatrixCost::differences(evals)
     }
+}
+
+/// A spring's end-force derivatives in the order (a, a), (a, b), (b, a), (b, b): by position and
+/// by velocity.
+struct Blocks {
+    position: [Matrix2<f64>; 4],
+    rate: [Matrix2<f64>; 4],
+}
+
+/// A straddling spring's end sits exactly at its pulley, where its direction is undefined.
+struct AtPulley;
+
+/// The blocks of a damped spring, T = k s + c λ̇ (0 while slack or clipped: None), its ends
+/// `ends` = [(a, v_a), (b, v_b)], over `pulley` if it straddles one; (k, l0, c) its stiffness,
+/// segment and damping. A chord: u = (b − a)/λ, P = I − u uᵀ, w = P (v_b − v_a)/λ,
+/// ∂F_a/∂b = u (k u + c w)ᵀ + (T/λ) P (∓ for the other blocks) and ∂F_a/∂v_b = c u uᵀ. The
+/// straddling spring pulls each end toward A: u_a = (A − a)/|A − a|, λ̇ = −u_a·v_a − u_b·v_b,
+/// g_a = −k u_a + c P_a v_a/|A − a|: ∂F_a/∂a = u_a g_aᵀ − (T/|A − a|) P_a, ∂F_a/∂b = u_a g_bᵀ,
+/// ∂F_a/∂v_b = −c u_a u_bᵀ.
+fn damped_blocks(
+    [(a, va), (b, vb)]: [(Vector2<f64>, Vector2<f64>); 2],
+    pulley: Option<Vector2<f64>>,
+    (k, l0, c): (f64, f64, f64),
+) -> Result<Option<Blocks>, AtPulley> {
+    let identity = Matrix2::identity();
+    let Some(pulley) = pulley else {
+        let d = b - a;
+        let length = d.norm();
+        if length <= l0 {
+            return Ok(None);
+        }
+        let u = d / length;
+        let dv = vb - va;
+        let t = crate::spring_tension(k, l0, c, length, u.dot(&dv));
+        if t <= 0.0 {
+            return Ok(None);
+        }
+        let along = u * u.transpose();
+        let across = identity - along;
+        let w = across * dv / length;
+        let g = u * (u * k + w * c).transpose() + across * (t / length);
+        let d = along * c;
+        return Ok(Some(Blocks {
+            position: [-g, g, g, -g],
+            rate: [-d, d, d, -d],
+        }));
+    };
+    let (da, db) = (pulley - a, pulley - b);
+    let (la, lb) = (da.norm(), db.norm());
+    if la == 0.0 || lb == 0.0 {
+        return Err(AtPulley);
+    }
+    if la + lb <= l0 {
+        return Ok(None);
+    }
+    let (ua, ub) = (da / la, db / lb);
+    let t = crate::spring_tension(k, l0, c, la + lb, -ua.dot(&va) - ub.dot(&vb));
+    if t <= 0.0 {
+        return Ok(None);
+    }
+    let (across_a, across_b) = (
+        identity - ua * ua.transpose(),
+        identity - ub * ub.transpose(),
+    );
+    let ga = -ua * k + across_a * va * (c / la);
+    let gb = -ub * k + across_b * vb * (c / lb);
+    Ok(Some(Blocks {
+        position: [
+            ua * ga.transpose() - across_a * (t / la),
+            ua * gb.transpose(),
+            ub * ga.transpose(),
+            ub * gb.transpose() - across_b * (t / lb),
+        ],
+        rate: [
+            -ua * ua.transpose() * c,
+            -ua * ub.transpose() * c,
+            -ub * ua.transpose() * c,
+            -ub * ub.transpose() * c,
+        ],
+    }))
 }
 
 #[cfg(test)]
@@ -361,14 +502,63 @@ mod tests {
             let qdd = vec![0.0; dofs];
             let len = model.iteration_pattern().len();
             let (mut analytic, mut differenced) = (vec![0.0; len], vec![0.0; len]);
-            prop_assert!(model.tangent_matrix(&state, c_q, &mut analytic));
+            prop_assert!(model.tangent_matrix(&state, (0.0, c_q), 0.0, &mut analytic));
             model.differenced_matrix(&state, &qdd, &[100.0, 100.0], 0.0, c_q, &mut differenced);
             let mut masses = vec![0.0; len];
-            prop_assert!(model.tangent_matrix(&state, 0.0, &mut masses));
+            prop_assert!(model.tangent_matrix(&state, (0.0, 0.0), 0.0, &mut masses));
             let scale = differenced
                 .iter()
                 .zip(&masses)
                 .fold(0.0f64, |m, (v, mass)| m.max((v - mass).abs()));
+            for (i, (a, d)) in analytic.iter().zip(&differenced).enumerate() {
+                prop_assert!((a - d).abs() <= 1e-6 * scale, "entry {}: {:e} vs {:e} (scale {:e})", i, a, d, scale);
+            }
+        }
+
+        /// The damped springs' analytic matrix (the printer example's C = 8.5 N s on the
+        /// paper's line) against the coloured differences of the same damped model, at
+        /// equilibria shaken as above with every node moving at up to `speed` (stored nodes
+        /// along the reel line only), with c_v = γh and c_q = βh²: S − diag(m) to 1e-6 of its
+        /// largest entry. The differences' steps keep off the damping's clip, T/k away.
+        #[test]
+        fn damped_tangent_matrix_matches_coloured_differences(
+            x in 0.42f64..0.62,
+            shake in 0.0f64..3e-5,
+            speed in 0.0f64..0.05,
+            seed in 0u32..1000,
+            h in 1e-5f64..1e-3,
+        ) {
+            let mut s = Scenario::paper();
+            s.cable.axial_damping = 8.5;
+            let mut model = Lumped::new(&s, Params::default()).unwrap();
+            let eq = model.equilibrium(&SplitRule::new(x, s.controller.tension_sum)).unwrap();
+            let mut state = eq.state.clone();
+            let (n, np) = (model.elements, model.positions_len());
+            for cable in 0..2 {
+                for j in 0..n {
+                    let phase = f64::from(seed) + (cable * n + j) as f64;
+                    let (ix, iz) = (model.x_index(cable, j), model.z_index(cable, j));
+                    state[ix] += shake * (1.7 * phase).sin();
+                    state[np + ix] = speed * (2.9 * phase).sin();
+                    if j >= model.stored[cable] {
+                        state[iz] += shake * (2.3 * phase).cos();
+                        state[np + iz] = speed * (3.1 * phase).cos();
+                    }
+                }
+            }
+            let (c_v, c_q) = (0.6 * h, 0.3 * h * h);
+            let qdd = vec![0.0; model.dofs()];
+            let len = model.iteration_pattern().len();
+            let (mut analytic, mut differenced, mut masses) = (vec![0.0; len], vec![0.0; len], vec![0.0; len]);
+            let damping = model.damping;
+            prop_assert!(model.tangent_matrix(&state, (c_v, c_q), damping, &mut analytic));
+            model.differenced_matrix(&state, &qdd, &[100.0, 100.0], c_v, c_q, &mut differenced);
+            prop_assert!(model.tangent_matrix(&state, (0.0, 0.0), damping, &mut masses));
+            let scale = differenced
+                .iter()
+                .zip(&masses)
+                .fold(0.0f64, |m, (v, mass)| m.max((v - mass).abs()));
+            prop_assert!(scale > 0.0);
             for (i, (a, d)) in analytic.iter().zip(&differenced).enumerate() {
                 prop_assert!((a - d).abs() <= 1e-6 * scale, "entry {}: {:e} vs {:e} (scale {:e})", i, a, d, scale);
             }

@@ -139,7 +139,10 @@ impl StaticProblem for Problem<'_> {
     /// λ' = 0, so the Kelvin–Voigt term and its position derivative vanish.
     fn jacobian(&mut self, u: &[f64], values: &mut [f64]) -> bool {
         self.load(u);
-        if !self.model.tangent_matrix(&self.y, 1.0, &mut self.tangent) {
+        if !self
+            .model
+            .tangent_matrix(&self.y, (0.0, 1.0), 0.0, &mut self.tangent)
+        {
             return false;
         }
         let kept = &self.pattern.kept;
