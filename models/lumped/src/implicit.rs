@@ -10,9 +10,10 @@
 //! The pattern does not depend on which nodes are stored, so pulley events never change it.
 
 use crate::Lumped;
+use crate::damped::{AtPulley, DampedBlocks, damped_blocks};
 use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
 use cdpr_numerics::differences::{CBRT_EPSILON, ColouredDifferences};
-use nalgebra::{Matrix2, Vector2};
+use nalgebra::Vector2;
 
 /// Buffers of the second-order form (allocated once per model).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -89,7 +90,7 @@ impl Lumped {
     ///
     /// With `damping` c = C/l0 ≠ 0 (the implicit path's damped springs; the statics pass 0 and
     /// keep the undamped blocks to the bit), T = k s + c λ̇ and the blocks gain the rate's
-    /// position dependence and c_v ∂F/∂q' ([`damped_blocks`]).
+    /// position dependence and c_v ∂F/∂q' ([`crate::damped`]).
     pub(crate) fn tangent_matrix(
         &self,
         state: &[f64],
@@ -182,7 +183,7 @@ impl Lumped {
         &self,
         cable: usize,
         j: usize,
-        blocks: &Blocks,
+        blocks: &DampedBlocks<2>,
         (c_v, c_q): (f64, f64),
         values: &mut [f64],
     ) {
@@ -375,86 +376,6 @@ impl Lumped {
         self.implicit.differences = Some(differences);
         MatrixCost::differences(evals)
     }
-}
-
-/// A spring's end-force derivatives in the order (a, a), (a, b), (b, a), (b, b): by position and
-/// by velocity.
-struct Blocks {
-    position: [Matrix2<f64>; 4],
-    rate: [Matrix2<f64>; 4],
-}
-
-/// A straddling spring's end sits exactly at its pulley, where its direction is undefined.
-struct AtPulley;
-
-/// The blocks of a damped spring, T = k s + c λ̇ (0 while slack or clipped: None), its ends
-/// `ends` = [(a, v_a), (b, v_b)], over `pulley` if it straddles one; (k, l0, c) its stiffness,
-/// segment and damping. A chord: u = (b − a)/λ, P = I − u uᵀ, w = P (v_b − v_a)/λ,
-/// ∂F_a/∂b = u (k u + c w)ᵀ + (T/λ) P (∓ for the other blocks) and ∂F_a/∂v_b = c u uᵀ. The
-/// straddling spring pulls each end toward A: u_a = (A − a)/|A − a|, λ̇ = −u_a·v_a − u_b·v_b,
-/// g_a = −k u_a + c P_a v_a/|A − a|: ∂F_a/∂a = u_a g_aᵀ − (T/|A − a|) P_a, ∂F_a/∂b = u_a g_bᵀ,
-/// ∂F_a/∂v_b = −c u_a u_bᵀ.
-fn damped_blocks(
-    [(a, va), (b, vb)]: [(Vector2<f64>, Vector2<f64>); 2],
-    pulley: Option<Vector2<f64>>,
-    (k, l0, c): (f64, f64, f64),
-) -> Result<Option<Blocks>, AtPulley> {
-    let identity = Matrix2::identity();
-    let Some(pulley) = pulley else {
-        let d = b - a;
-        let length = d.norm();
-        if length <= l0 {
-            return Ok(None);
-        }
-        let u = d / length;
-        let dv = vb - va;
-        let t = crate::spring_tension(k, l0, c, length, u.dot(&dv));
-        if t <= 0.0 {
-            return Ok(None);
-        }
-        let along = u * u.transpose();
-        let across = identity - along;
-        let w = across * dv / length;
-        let g = u * (u * k + w * c).transpose() + across * (t / length);
-        let d = along * c;
-        return Ok(Some(Blocks {
-            position: [-g, g, g, -g],
-            rate: [-d, d, d, -d],
-        }));
-    };
-    let (da, db) = (pulley - a, pulley - b);
-    let (la, lb) = (da.norm(), db.norm());
-    if la == 0.0 || lb == 0.0 {
-        return Err(AtPulley);
-    }
-    if la + lb <= l0 {
-        return Ok(None);
-    }
-    let (ua, ub) = (da / la, db / lb);
-    let t = crate::spring_tension(k, l0, c, la + lb, -ua.dot(&va) - ub.dot(&vb));
-    if t <= 0.0 {
-        return Ok(None);
-    }
-    let (across_a, across_b) = (
-        identity - ua * ua.transpose(),
-        identity - ub * ub.transpose(),
-    );
-    let ga = -ua * k + across_a * va * (c / la);
-    let gb = -ub * k + across_b * vb * (c / lb);
-    Ok(Some(Blocks {
-        position: [
-            ua * ga.transpose() - across_a * (t / la),
-            ua * gb.transpose(),
-            ub * ga.transpose(),
-            ub * gb.transpose() - across_b * (t / lb),
-        ],
-        rate: [
-            -ua * ua.transpose() * c,
-            -ua * ub.transpose() * c,
-            -ub * ua.transpose() * c,
-            -ub * ub.transpose() * c,
-        ],
-    }))
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@
 //! (stored nodes keep z = ż = 0). The number of stored nodes r_i per cable is the model's discrete
 //! mode.
 
+mod damped;
 pub mod fixed_cable;
 mod implicit;
 mod modal;
