@@ -95,49 +95,52 @@ impl FeSpatial {
         local
     }
 
-    /// Largest step over which the block's forces are smooth in its positions: a quarter of the
-    /// element's |stretch| (a change δ of l moves h by δ/N, δ for the stored element), and with
-    /// axial damping of the distance h |EA ε + C ε'|/EA to the damping's clip at N = 0.
-    fn block_step_limit(&self, block: Block, [q, v, _]: &Local) -> f64 {
-        let at = |x: &[f64; LOCAL], k: usize| Vector3::new(x[k], x[k + 1], x[k + 2]);
+    /// Largest step over which the block's forces are smooth in its positions: its element's
+    /// reach ([`FeSpatial::element_reach`]).
+    fn block_step_limit(&self, block: Block, local: &Local) -> f64 {
         match block {
-            Block::Free { .. } => {
-                let h = q[6] / self.elements as f64;
-                let stretch = (at(q, 3) - at(q, 0)).norm() - h;
-                let mut limit = 0.25 * stretch.abs();
-                if self.axial_damping != 0.0 && stretch > 0.0 {
-                    let s = ElementState::new(
-                        (at(q, 0), at(v, 0)),
-                        (at(q, 3), at(v, 3)),
-                        v[6],
-                        h,
-                        1.0 / self.elements as f64,
-                    );
-                    let ea = self.material.ea;
-                    let pull = ea * stretch / h + self.axial_damping * element::strain_rate(&s);
-                    limit = limit.min(0.25 * h * (pull / ea).abs());
-                }
-                limit
+            Block::Free { .. } | Block::Stored { .. } => {
+                self.element_reach(&self.block_element(block, local))
             }
-            Block::Stored { .. } => 0.25 * (q[0] - (self.modelled_length - q[1])).abs(),
             Block::Effector => f64::INFINITY,
         }
     }
 
-    /// The block's part of R (the tensions left out: they do not depend on the unknowns).
-    fn block_residual(&self, block: Block, [q, v, a]: &Local) -> [f64; LOCAL] {
+    /// The element state of a free or stored block at its local unknowns.
+    fn block_element(&self, block: Block, [q, v, _]: &Local) -> ElementState<3> {
         let vector = |x: &[f64; LOCAL], k: usize| Vector3::new(x[k], x[k + 1], x[k + 2]);
-        let mut r = [0.0; LOCAL];
         match block {
-            Block::Free { e, .. } => {
+            Block::Stored { cable } => {
+                let (pulley, reel) = (self.pulley(cable), self.reels[cable]);
+                ElementState::new(
+                    (pulley + reel * q[0], reel * v[0]),
+                    (pulley, Vector3::zeros()),
+                    v[1],
+                    self.modelled_length - q[1],
+                    -1.0,
+                )
+            }
+            _ => {
                 let n = self.elements as f64;
-                let s = ElementState::new(
+                ElementState::new(
                     (vector(q, 0), vector(v, 0)),
                     (vector(q, 3), vector(v, 3)),
                     v[6],
                     q[6] / n,
                     1.0 / n,
-                );
+                )
+            }
+        }
+    }
+
+    /// The block's part of R (the tensions left out: they do not depend on the unknowns).
+    fn block_residual(&self, block: Block, local: &Local) -> [f64; LOCAL] {
+        let a = &local[2];
+        let vector = |x: &[f64; LOCAL], k: usize| Vector3::new(x[k], x[k + 1], x[k + 2]);
+        let mut r = [0.0; LOCAL];
+        match block {
+            Block::Free { e, .. } => {
+                let s = self.block_element(block, local);
                 let (ra, rb, rl) = element::residual_at_chord(
                     &self.material,
                     &self.coefficients[e - 1],
@@ -153,14 +156,8 @@ impl FeSpatial {
                 r[6] = rl;
             }
             Block::Stored { cable } => {
-                let (pulley, reel) = (self.pulley(cable), self.reels[cable]);
-                let s = ElementState::new(
-                    (pulley + reel * q[0], reel * v[0]),
-                    (pulley, Vector3::zeros()),
-                    v[1],
-                    self.modelled_length - q[1],
-                    -1.0,
-                );
+                let reel = self.reels[cable];
+                let s = self.block_element(block, local);
                 let (r_reel, _, r_l) = element::residual_at_chord(
                     &self.material,
                     &self.stored_coefficients,

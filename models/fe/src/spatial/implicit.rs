@@ -6,10 +6,30 @@
 //! probe reaches the tension-only kink.
 
 use super::FeSpatial;
+use crate::element::{self, ElementState};
 use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
 use cdpr_numerics::differences::ColouredDifferences;
 
 impl FeSpatial {
+    /// How far an element's ends may move with its forces smooth: a quarter of its |stretch|
+    /// ||Δ| − h| (the tension-only kink), and with axial damping, while it stretches or
+    /// shortens, of h |EA ε + C ε'|/EA (the damping's clip at N = 0; at rest that is the
+    /// stretch itself, so rests are unchanged). A change δ of l moves h by δ/N (δ for the
+    /// stored element), so the same reach is safe for l.
+    pub(super) fn element_reach(&self, s: &ElementState<3>) -> f64 {
+        let stretch = (s.rb - s.ra).norm() - s.h;
+        let mut reach = 0.25 * stretch.abs();
+        if self.axial_damping != 0.0 && stretch > 0.0 {
+            let rate = element::strain_rate(s);
+            if rate != 0.0 {
+                let ea = self.material.ea;
+                let pull = ea * stretch / s.h + self.axial_damping * rate;
+                reach = reach.min(0.25 * s.h * (pull / ea).abs());
+            }
+        }
+        reach
+    }
+
     /// Every coordinate element e of `cable` moves: its end nodes' (those that are free or
     /// the effector) and l_i.
     fn element_dofs(&self, cable: usize, e: usize) -> Vec<usize> {
@@ -76,20 +96,18 @@ impl SecondOrderForm for FeSpatial {
         spring_round_off(self.material.ea / shortest, &state[..self.positions_len()])
     }
 
-    /// Per coordinate, a quarter of the smallest |stretch| ||Δ| − h| of the elements it moves
-    /// (ρ_i: the stored element's).
+    /// Per coordinate, the smallest smooth reach ([`FeSpatial::element_reach`]) of the elements
+    /// it moves (ρ_i: the stored element's).
     fn smooth_reach(&self, state: &[f64], out: &mut [f64]) {
         out.fill(f64::INFINITY);
         for cable in 0..self.robot.cables() {
             for e in 1..=self.elements {
-                let s = self.free_element(state, cable, e);
-                let limit = 0.25 * ((s.rb - s.ra).norm() - s.h).abs();
+                let limit = self.element_reach(&self.free_element(state, cable, e));
                 for d in self.element_dofs(cable, e) {
                     out[d] = out[d].min(limit);
                 }
             }
-            let s = self.stored_element(state, cable);
-            let limit = 0.25 * ((s.rb - s.ra).norm() - s.h).abs();
+            let limit = self.element_reach(&self.stored_element(state, cable));
             let (l, rho) = (self.l_index(cable), self.l_index(cable) + 1);
             out[l] = out[l].min(limit);
             out[rho] = out[rho].min(limit);
