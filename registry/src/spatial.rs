@@ -103,23 +103,19 @@ pub(crate) fn run_robot(scenario: &Scenario) -> Result<(Robot<3>, ModelKind), Er
 /// pulled by tension or driven by length (lumped: the passage rate of nodes; FE: Du's prescribed
 /// free lengths), on either integrator.
 fn check_massive(robot: &Robot<3>, kind: ModelKind) -> Result<(), Error> {
-    let refuse = |key: &'static str, value: String, allowed: String| -> Result<(), Error> {
-        Err(out_of_range(key, value, allowed).into())
-    };
+    if robot.cables() >= 3 {
+        return Ok(());
+    }
     let label = match kind {
         ModelKind::Fe => "FE",
         _ => kind.name(),
     };
-    if robot.cables() < 3 {
-        return refuse(
-            "robot.anchors",
-            format!("{} anchors with model.kind = \"{kind}\"", robot.cables()),
-            format!(
-                "3 to 8 anchors for the spatial {label} cables (two cables in space run elastic)"
-            ),
-        );
-    }
-    Ok(())
+    Err(out_of_range(
+        "robot.anchors",
+        format!("{} anchors with model.kind = \"{kind}\"", robot.cables()),
+        format!("3 to 8 anchors for the spatial {label} cables (two cables in space run elastic)"),
+    )
+    .into())
 }
 
 /// The spatial FE model of `scenario` (its `[model]` keys), its modelled length checked against

@@ -10,10 +10,9 @@
 //! The pattern does not depend on which nodes are stored, so pulley events never change it.
 
 use crate::Lumped;
-use crate::damped::{AtPulley, DampedBlocks, damped_blocks};
+use crate::damped::{AtPulley, SpringBlocks, damped_blocks, undamped_blocks};
 use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
 use cdpr_numerics::differences::{CBRT_EPSILON, ColouredDifferences};
-use nalgebra::Vector2;
 
 /// Buffers of the second-order form (allocated once per model).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -101,89 +100,39 @@ impl Lumped {
         let n = self.elements;
         self.mass_matrix_into(values);
         let (k, l0) = (self.stiffness, self.segment);
-        let outer = |u: Vector2<f64>, w: Vector2<f64>| u * w.transpose();
-        let identity = nalgebra::Matrix2::identity();
         for cable in 0..2 {
             let stored = self.stored[cable];
             for j in 0..n {
-                let (a, b) = (self.node(state, cable, j), self.node(state, cable, j + 1));
-                if damping != 0.0 {
+                let pulley = (j + 1 == stored).then(|| self.pulley(cable));
+                let blocks = if damping != 0.0 {
                     let ends = [j, j + 1].map(|k| {
                         (
                             self.node(state, cable, k),
                             self.node_velocity(state, cable, k),
                         )
                     });
-                    let pulley = (j + 1 == stored).then(|| self.pulley(cable));
-                    let blocks = match damped_blocks(ends, pulley, (k, l0, damping)) {
-                        Ok(Some(blocks)) => blocks,
-                        Ok(None) => continue,
-                        Err(AtPulley) => return false,
-                    };
-                    self.add_blocks(cable, j, &blocks, (c_v, c_q), values);
-                    continue;
-                }
-                // ∂F_a/∂a, ∂F_a/∂b, ∂F_b/∂a, ∂F_b/∂b.
-                let blocks = if j + 1 == stored {
-                    let pulley = self.pulley(cable);
-                    let (da, db) = (pulley - a, pulley - b);
-                    let (la, lb) = (da.norm(), db.norm());
-                    if la == 0.0 || lb == 0.0 {
-                        return false;
-                    }
-                    let stretch = la + lb - l0;
-                    if stretch <= 0.0 {
-                        continue;
-                    }
-                    let t = k * stretch;
-                    let (ua, ub) = (da / la, db / lb);
-                    let across_a = (identity - outer(ua, ua)) * (t / la);
-                    let across_b = (identity - outer(ub, ub)) * (t / lb);
-                    [
-                        -outer(ua, ua) * k - across_a,
-                        -outer(ua, ub) * k,
-                        -outer(ub, ua) * k,
-                        -outer(ub, ub) * k - across_b,
-                    ]
+                    damped_blocks(ends, pulley, (k, l0, damping))
                 } else {
-                    let d = b - a;
-                    let length = d.norm();
-                    let stretch = length - l0;
-                    if stretch <= 0.0 {
-                        continue;
-                    }
-                    let u = d / length;
-                    let along = outer(u, u);
-                    let tangent = along * k + (identity - along) * (k * stretch / length);
-                    [-tangent, tangent, tangent, -tangent]
+                    let ends = (self.node(state, cable, j), self.node(state, cable, j + 1));
+                    undamped_blocks(ends, pulley, (k, l0))
                 };
-                for (block, (row, col)) in
-                    blocks
-                        .iter()
-                        .zip([(j, j), (j, j + 1), (j + 1, j), (j + 1, j + 1)])
-                {
-                    for r in 0..2 {
-                        if r == 1 && row < stored {
-                            continue;
-                        }
-                        for c in 0..2 {
-                            values[self.pattern_index(cable, row, col, r, c)] -=
-                                c_q * block[(r, c)];
-                        }
-                    }
+                match blocks {
+                    Ok(Some(blocks)) => self.add_blocks(cable, j, &blocks, (c_v, c_q), values),
+                    Ok(None) => {}
+                    Err(AtPulley) => return false,
                 }
             }
         }
         true
     }
 
-    /// Subtracts c_q times the position blocks and c_v times the rate blocks of spring j of
-    /// `cable` from S, a stored node's z row left to its mass.
+    /// Subtracts c_q times the position blocks and c_v times the rate blocks (a damped
+    /// spring's) of spring j of `cable` from S, a stored node's z row left to its mass.
     fn add_blocks(
         &self,
         cable: usize,
         j: usize,
-        blocks: &DampedBlocks<2>,
+        blocks: &SpringBlocks<2>,
         (c_v, c_q): (f64, f64),
         values: &mut [f64],
     ) {
@@ -197,8 +146,12 @@ impl Lumped {
                     continue;
                 }
                 for c in 0..2 {
-                    values[self.pattern_index(cable, row, col, r, c)] -=
-                        c_q * blocks.position[k][(r, c)] + c_v * blocks.rate[k][(r, c)];
+                    let entry = &mut values[self.pattern_index(cable, row, col, r, c)];
+                    let position = blocks.position[k][(r, c)];
+                    match &blocks.rate {
+                        None => *entry -= c_q * position,
+                        Some(rate) => *entry -= c_q * position + c_v * rate[k][(r, c)],
+                    }
                 }
             }
         }
@@ -296,16 +249,14 @@ impl SecondOrderForm for Lumped {
         for cable in 0..2 {
             let r = self.stored[cable];
             for j in 0..n {
-                let length = self.spring_length(state, cable, j);
-                let mut limit = 0.25 * (length - self.segment).abs();
-                if self.damping != 0.0 {
-                    // The damping's clip, T = max(k s + c λ̇, 0), lies T/k away (s at rest).
-                    let (_, rate, _, _) = self.spring(state, cable, j);
-                    if rate != 0.0 {
-                        let pull = self.stiffness * (length - self.segment) + self.damping * rate;
-                        limit = limit.min(0.25 * (pull / self.stiffness).abs());
-                    }
-                }
+                let (length, rate) = if self.damping == 0.0 {
+                    (self.spring_length(state, cable, j), 0.0)
+                } else {
+                    let (length, rate, _, _) = self.spring(state, cable, j);
+                    (length, rate)
+                };
+                let spring = (self.stiffness, self.segment, self.damping);
+                let mut limit = crate::damped::smooth_reach(spring, length, rate);
                 if j + 1 == r {
                     let pulley = self.pulley(cable);
                     for node in [j, j + 1] {

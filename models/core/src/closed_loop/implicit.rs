@@ -24,9 +24,10 @@ pub(super) struct StepStart<const D: usize> {
     /// W and D at t_n [J].
     work: f64,
     dissipated: f64,
-    /// The time the model's reels were last driven at (reels driven by length): the Newton
-    /// iterations of a step evaluate at one time, so the commanded lengths' rates (three
-    /// distributions) are computed once per time.
+    /// The time the model's reels were last driven at (reels driven by length; set by
+    /// `ClosedLoop::drive_reels`, the loop's only setter of the drive): the Newton iterations of
+    /// a step, its end and the next step's start evaluate at one time, so the commanded
+    /// lengths' rates (three distributions) are computed once per time.
     pub(super) driven_at: Option<f64>,
     /// The time of the last audit rates (reel power, dissipation) at the implicit path's step
     /// end, and their values: the step's end, the tail's rate there and the next step's start
@@ -45,10 +46,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
             return self.step_start.audited;
         }
         let reel = self.model.reel_speeds(model_state);
-        let audits = (
-            self.model.reel_power(model_state, &cmd.tensions, &reel),
-            self.model.dissipation(model_state),
-        );
+        let audits = self.audit_rates(model_state, &cmd.tensions, &reel);
         self.step_start.audited_at = Some(t);
         self.step_start.audited = audits;
         audits
@@ -167,7 +165,6 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
     }
 
     fn begin_step(&mut self, t: f64, y: &[f64], h: f64) {
-        self.step_start.driven_at = None;
         self.drive_reels_at(t);
         let n = self.model_len();
         let c = self.controller_len();
@@ -261,10 +258,8 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         let effector = self.model.effector(&y[..n]);
         let reference = self.reference(t);
         let cmd = self.command_with(t, &reference, &effector, &y[n..n + c]);
-        let (rates, audits) = out.split_at_mut(c);
-        self.controller
-            .state_rate(&reference, &effector, &y[n..n + c], cmd.saturated, rates);
-        (audits[0], audits[1]) = self.audits_at(t, &y[..n], &cmd);
+        let audits = self.audits_at(t, &y[..n], &cmd);
+        self.controller_and_audit_rates(y, (&reference, &effector), cmd.saturated, audits, out);
     }
 
     /// The model's and the controller's states; the energy audits stay out of the norm.

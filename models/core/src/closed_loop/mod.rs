@@ -287,23 +287,34 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         }
     }
 
-    /// Rates of the states after the model's (controller, W', D') at state `y` under `cmd`,
-    /// with the reference and the effector of (t, y) and the reels' speeds there.
+    /// The audits' rates W' = the reels' power (Σ T_i v_reel,i, or a driven reel's) and D' =
+    /// the model's dissipation [W] at `model_state` under the commanded `tensions`, the reels
+    /// turning at `reel`.
+    fn audit_rates(&self, model_state: &[f64], tensions: &Tensions, reel: &PerCable) -> (f64, f64) {
+        (
+            self.model.reel_power(model_state, tensions, reel),
+            self.model.dissipation(model_state),
+        )
+    }
+
+    /// Rates of the states after the model's (controller, W', D') at state `y`, with the
+    /// reference and the effector of (t, y), whether the command saturates there, and the
+    /// audits' rates ([`ClosedLoop::audit_rates`]).
     fn controller_and_audit_rates(
         &self,
         y: &[f64],
         (reference, effector): (&Reference<D>, &Effector<D>),
-        (cmd, reel): (&Command, &PerCable),
+        saturated: bool,
+        (power, dissipation): (f64, f64),
         out: &mut [f64],
     ) {
         let n = self.model_len();
         let c = self.controller_len();
-        let model_state = &y[..n];
         let (rates, audits) = out.split_at_mut(c);
         self.controller
-            .state_rate(reference, effector, &y[n..n + c], cmd.saturated, rates);
-        audits[0] = self.model.reel_power(model_state, &cmd.tensions, reel);
-        audits[1] = self.model.dissipation(model_state);
+            .state_rate(reference, effector, &y[n..n + c], saturated, rates);
+        audits[0] = power;
+        audits[1] = dissipation;
     }
 }
 
@@ -327,6 +338,7 @@ impl<M: CableModel<D>, const D: usize> OdeSystem for ClosedLoop<M, D> {
         let reel = self
             .model
             .rhs_and_reel_speeds(t, &y[..n], &cmd.tensions, model_rate);
-        self.controller_and_audit_rates(y, (&reference, &effector), (&cmd, &reel), tail);
+        let audits = self.audit_rates(&y[..n], &cmd.tensions, &reel);
+        self.controller_and_audit_rates(y, (&reference, &effector), cmd.saturated, audits, tail);
     }
 }

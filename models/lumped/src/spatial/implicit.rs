@@ -231,14 +231,14 @@ impl SecondOrderForm for LumpedSpatial {
         for cable in 0..self.robot().cables() {
             let r = self.stored[cable];
             for j in 0..n {
-                let length = self.spring_length(state, cable, j);
-                let mut limit = 0.25 * (length - self.segment).abs();
-                if self.damping != 0.0 {
-                    // The damping's clip, T = max(k0 s + c λ̇, 0), lies T/k0 away.
-                    let (_, rate, _, _) = self.spring(state, cable, j);
-                    let pull = self.stiffness * (length - self.segment) + self.damping * rate;
-                    limit = limit.min(0.25 * (pull / self.stiffness).abs());
-                }
+                let (length, rate) = if self.damping == 0.0 {
+                    (self.spring_length(state, cable, j), 0.0)
+                } else {
+                    let (length, rate, _, _) = self.spring(state, cable, j);
+                    (length, rate)
+                };
+                let spring = (self.stiffness, self.segment, self.damping);
+                let mut limit = crate::damped::smooth_reach(spring, length, rate);
                 if j + 1 == r {
                     let pulley = self.pulley(cable);
                     for node in [j, j + 1] {

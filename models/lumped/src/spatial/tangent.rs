@@ -6,15 +6,8 @@
 //! straddling spring's ∂F_a/∂a = −k u_a u_aᵀ − (T/|A − a|)(I − u_a u_aᵀ), ∂F_a/∂b = −k u_a u_bᵀ.
 
 use super::LumpedSpatial;
-use crate::damped::{AtPulley, damped_blocks};
-use nalgebra::{Matrix3, Vector3};
-
-/// A spring's end-force derivatives in the order (a, a), (a, b), (b, a), (b, b): by position,
-/// and by velocity for a damped spring.
-struct SpringBlocks {
-    position: [Matrix3<f64>; 4],
-    rate: Option<[Matrix3<f64>; 4]>,
-}
+use crate::damped::{AtPulley, SpringBlocks, damped_blocks, undamped_blocks};
+use nalgebra::Matrix3;
 
 impl LumpedSpatial {
     /// S into `values` (the iteration pattern's order). False where a straddling end sits
@@ -67,76 +60,18 @@ impl LumpedSpatial {
         state: &[f64],
         cable: usize,
         j: usize,
-    ) -> Result<Option<SpringBlocks>, AtPulley> {
-        let (a, b) = (self.node(state, cable, j), self.node(state, cable, j + 1));
-        let straddling = j + 1 == self.stored[cable];
-        if self.damping != 0.0 {
-            let ends = [j, j + 1].map(|k| {
-                (
-                    self.node(state, cable, k),
-                    self.node_velocity(state, cable, k),
-                )
-            });
-            let pulley = straddling.then(|| self.pulley(cable));
-            let blocks = damped_blocks(ends, pulley, (self.stiffness, self.segment, self.damping))?;
-            return Ok(blocks.map(|b| SpringBlocks {
-                position: b.position,
-                rate: Some(b.rate),
-            }));
+    ) -> Result<Option<SpringBlocks<3>>, AtPulley> {
+        let pulley = (j + 1 == self.stored[cable]).then(|| self.pulley(cable));
+        if self.damping == 0.0 {
+            let ends = (self.node(state, cable, j), self.node(state, cable, j + 1));
+            return undamped_blocks(ends, pulley, (self.stiffness, self.segment));
         }
-        if straddling {
-            self.straddling_blocks(cable, (a, b))
-        } else {
-            Ok(self.chord_blocks(b - a))
-        }
-    }
-
-    /// An undamped chord spring's blocks, d = b − a.
-    fn chord_blocks(&self, d: Vector3<f64>) -> Option<SpringBlocks> {
-        let (k, l0) = (self.stiffness, self.segment);
-        let identity = Matrix3::identity();
-        let length = d.norm();
-        let stretch = length - l0;
-        if stretch <= 0.0 {
-            return None;
-        }
-        let u = d / length;
-        let along = u * u.transpose();
-        let tangent = along * k + (identity - along) * (k * stretch / length);
-        Some(SpringBlocks {
-            position: [-tangent, tangent, tangent, -tangent],
-            rate: None,
-        })
-    }
-
-    /// The undamped straddling spring's blocks, its ends (a, b) on either side of the pulley.
-    fn straddling_blocks(
-        &self,
-        cable: usize,
-        (a, b): (Vector3<f64>, Vector3<f64>),
-    ) -> Result<Option<SpringBlocks>, AtPulley> {
-        let (k, l0) = (self.stiffness, self.segment);
-        let identity = Matrix3::identity();
-        let pulley = self.pulley(cable);
-        let (da, db) = (pulley - a, pulley - b);
-        let (la, lb) = (da.norm(), db.norm());
-        if la == 0.0 || lb == 0.0 {
-            return Err(AtPulley);
-        }
-        let stretch = la + lb - l0;
-        if stretch <= 0.0 {
-            return Ok(None);
-        }
-        let (ua, ub): (Vector3<f64>, Vector3<f64>) = (da / la, db / lb);
-        let t = k * stretch;
-        Ok(Some(SpringBlocks {
-            position: [
-                -ua * ua.transpose() * k - (identity - ua * ua.transpose()) * (t / la),
-                -ua * ub.transpose() * k,
-                -ub * ua.transpose() * k,
-                -ub * ub.transpose() * k - (identity - ub * ub.transpose()) * (t / lb),
-            ],
-            rate: None,
-        }))
+        let ends = [j, j + 1].map(|k| {
+            (
+                self.node(state, cable, k),
+                self.node_velocity(state, cable, k),
+            )
+        });
+        damped_blocks(ends, pulley, (self.stiffness, self.segment, self.damping))
     }
 }
