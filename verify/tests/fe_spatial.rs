@@ -376,18 +376,29 @@ proptest! {
     /// unknowns) against coloured central differences of the whole residual, at states near the
     /// Hangprinter's rest (nodes moved by up to 2 mm and moving at up to 0.05 m/s, l and ρ
     /// rates too), N = 1 … 12, with and without the print example's axial damping C = 8.5 N s,
-    /// over c_v = γh and c_q = βh² of h = 1e-5 … 1e-3 s: S − M(q) to 1e-6 of its largest entry.
+    /// under tension reels and with the reels driving the lengths (Du's form rewritten from the
+    /// blocks, commanded l̇0 and l̈0 random), over c_v = γh and c_q = βh² of h = 1e-5 … 1e-3 s:
+    /// S − M(q) to 1e-6 of its largest entry.
     /// Both are central differences with the same steps' rule, each within ~1e-9 of the exact
     /// derivative; a block left out or a coupling dropped (the l columns of M(q), the effector's
     /// block) is of the order of the entries themselves.
     #[test]
     fn the_element_matrix_matches_coloured_differences(
-        elements in 1usize..12, damped in any::<bool>(), seed in 0u64..1000, h in 1e-5f64..1e-3,
+        elements in 1usize..12, damped in any::<bool>(), driven in any::<bool>(),
+        seed in 0u64..1000, h in 1e-5f64..1e-3,
     ) {
+        use cdpr_bench::core::model::CableModel;
+        use cdpr_bench::core::robot::PerCable;
         use cdpr_bench::core::second_order::SecondOrderForm;
         let (mut model, y, mut jiggle) = shaken_rest(elements, seed, 0.05);
         if damped {
             model.axial_damping = 8.5;
+        }
+        if driven {
+            model.lock_reels(true);
+            let rates = PerCable::from_fn(4, |_| jiggle.next(0.05));
+            let accelerations = PerCable::from_fn(4, |_| jiggle.next(2.0));
+            model.drive_reels(&rates, &accelerations);
         }
         let np = model.positions_len();
         let tensions = [14.0, 13.0, 11.0, 12.5];

@@ -270,3 +270,55 @@ impl FeSpatial {
         matrix
     }
 }
+
+impl FeSpatial {
+    /// S of Du's form (reels driven by length, MODELS.md FE.5.6) from the element blocks. Its
+    /// node and effector rows are the tension form's with l_i'' = a_i(l_i', t) = l̈0_i +
+    /// (l̇0_i − l_i')/τ put in: ∂/∂q and ∂/∂q' are the blocks' at q''_l = a_i (M(q)'s l
+    /// columns times a_i included), plus c_v ∂R/∂l_i'' ∂a_i/∂l_i' = −(c_v/τ) M_{k,l}; ∂/∂q''
+    /// drops its l columns M_{k,l}. The l_i rows read l_i'' − a_i (S_ll = 1 + c_v/τ), the ρ_i
+    /// rows ρ_i'' = 0 (the stored cable is on the reel).
+    pub(super) fn driven_block_matrix(
+        &mut self,
+        state: &[f64],
+        qdd: &[f64],
+        tensions: &[f64],
+        (c_v, c_q): (f64, f64),
+        values: &mut [f64],
+    ) {
+        let mut commanded = qdd.to_vec();
+        for cable in 0..self.robot.cables() {
+            commanded[self.l_index(cable)] = self.commanded_l_acceleration(state, cable);
+        }
+        self.block_matrix(state, &commanded, [c_q, c_v, 1.0], values);
+        let mut sys = std::mem::take(&mut self.system);
+        self.assemble_into(&mut sys, state, tensions, false);
+        let pattern = self.iteration_pattern();
+        let slot = |row: usize, col: usize| {
+            pattern
+                .binary_search(&(row, col))
+                .expect("an l column's entry lies in the pattern")
+        };
+        let held = 1.0 + c_v / cdpr_core::robot::reels::REEL_TIME_CONSTANT;
+        let nn = self.elements - 1;
+        for cable in 0..self.robot.cables() {
+            let l = self.l_index(cable);
+            for k in 1..self.elements {
+                let coupling = sys.l_column[cable * nn + k - 1];
+                for axis in 0..3 {
+                    values[slot(self.node_index(cable, k, axis), l)] -= held * coupling[axis];
+                }
+            }
+            for axis in 0..3 {
+                values[slot(self.effector_index(axis), l)] -= held * sys.effector_l[cable][axis];
+            }
+        }
+        // The (l_i, ρ_i) pairs are the last coordinates.
+        let first = self.l_index(0);
+        for (e, &(row, col)) in pattern.iter().enumerate().filter(|(_, rc)| rc.0 >= first) {
+            let diagonal = if (row - first) % 2 == 0 { held } else { 1.0 };
+            values[e] = if col == row { diagonal } else { 0.0 };
+        }
+        self.system = sys;
+    }
+}

@@ -1,8 +1,8 @@
 //! The spatial FE robot's second-order form R = M(q) q'' − F(q, q', T) for the implicit path
 //! (MODELS.md FE.9.3): R from the star's assembly ([`super::star::StarSystem::residual`]), the
-//! iteration matrix element by element ([`super::blocks`]), or by coloured central differences
-//! of R over the star's pattern ([`ColouredDifferences`]) when the reels prescribe the lengths;
-//! each position step kept within a quarter of the stretch of the elements it moves so that no
+//! iteration matrix element by element ([`super::blocks`]; the tests' reference: coloured
+//! central differences of R over the star's pattern, [`ColouredDifferences`]), each position
+//! step kept within a quarter of the stretch of the elements it moves so that no
 //! probe reaches the tension-only kink.
 
 use super::FeSpatial;
@@ -124,9 +124,8 @@ impl SecondOrderForm for FeSpatial {
         self.system.residual(qdd, r);
     }
 
-    /// Element by element ([`super::blocks`]) under tension reels; coloured differences of
-    /// the residual when the reels prescribe the lengths (Du's form rewrites the l rows, which
-    /// the element kernel does not).
+    /// Element by element ([`super::blocks`]), under tension reels or, rewritten for Du's
+    /// form, with the reels prescribing the lengths.
     fn iteration_matrix(
         &mut self,
         state: &[f64],
@@ -137,9 +136,10 @@ impl SecondOrderForm for FeSpatial {
         values: &mut [f64],
     ) -> MatrixCost {
         if self.length_driven {
-            return self.differenced_matrix(state, qdd, tensions, c_v, c_q, values);
+            self.driven_block_matrix(state, qdd, tensions, (c_v, c_q), values);
+        } else {
+            self.block_matrix(state, qdd, [c_q, c_v, 1.0], values);
         }
-        self.block_matrix(state, qdd, [c_q, c_v, 1.0], values);
         // No full residual: per block one base and 7 × (1 + 2 + 2) kernel probes, the kernels
         // of about 36 residual sweeps, which is the refresh rule's price.
         MatrixCost::without_residuals(BLOCK_MATRIX_PRICE)

@@ -43,8 +43,7 @@ pub struct FeSpatial {
     /// Accelerations of the free nodes (cable-major) and of (l_i, ρ_i), per solve.
     node_accelerations: Vec<Vector3<f64>>,
     border_accelerations: Vec<[f64; 2]>,
-    /// The implicit path's coloured differences (built at the first iteration matrix they
-    /// make: reels driven by length, and the tests' reference).
+    /// The coloured differences of the tests' reference matrix (built at its first call).
     differences: Option<cdpr_numerics::differences::ColouredDifferences>,
     /// Where the element blocks' entries go in the iteration pattern (built at the first
     /// element-by-element matrix, [`blocks`]).
@@ -145,6 +144,14 @@ impl FeSpatial {
             prescribing: vec![0.0; m],
             prescribing_state: Vec::new(),
         }
+    }
+
+    /// Locks every reel (or hands it to the commanded tensions): the length reels holding still
+    /// (MODELS.md §11, the firmware's printer between moves) — Du's form with no command, each
+    /// l_i held by the reel loop, the stored cable on the reel.
+    pub fn lock_reels(&mut self, locked: bool) {
+        self.length_driven = locked;
+        self.drive = None;
     }
 
     /// Number of generalised coordinates n = 3m(N − 1) + 3 + 2m.
@@ -562,7 +569,8 @@ impl CableModel<3> for FeSpatial {
         }
     }
 
-    /// The effector, each free node with its chord's tangent, l_i and ρ_i moving material.
+    /// The effector, each free node with its chord's tangent, l_i and ρ_i moving material —
+    /// held (frozen) when the reels drive the lengths or are locked.
     fn modal_layout(&self, y: &[f64]) -> cdpr_core::modal_layout::ModalLayout {
         use cdpr_core::modal_layout::{Dof, ModalLayout};
         let mut dofs = vec![Dof::Effector {
@@ -570,6 +578,7 @@ impl CableModel<3> for FeSpatial {
             mass: self.robot.effector_mass,
         }];
         let mu = self.material.mu;
+        let mut frozen = Vec::new();
         for c in 0..self.robot.cables() {
             let l = self.free_length(y, c);
             let h = l / self.elements as f64;
@@ -585,6 +594,10 @@ impl CableModel<3> for FeSpatial {
                 });
             }
             let li = self.l_index(c);
+            if self.length_driven {
+                frozen.extend([li, li + 1]);
+                continue;
+            }
             dofs.push(Dof::Axial {
                 cable: c,
                 index: li,
@@ -596,9 +609,6 @@ impl CableModel<3> for FeSpatial {
                 mass: mu * (self.modelled_length - l),
             });
         }
-        ModalLayout {
-            dofs,
-            frozen: Vec::new(),
-        }
+        ModalLayout { dofs, frozen }
     }
 }
