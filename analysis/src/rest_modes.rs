@@ -8,10 +8,11 @@
 //! analytic iteration matrix S(c_q) = M − c_q ∂F/∂q at q' = 0, q'' = 0 (S(1) − S(0) = K), over
 //! the coordinates the model's layout leaves free. K is symmetric for conservative forces; its
 //! asymmetry is reported, the symmetric part solved, and the frequencies come out in ascending
-//! order. The dense self-adjoint eigen-solve costs O(n³): it is bounded by
+//! order. A lumped (diagonal) M scales K by M^(−1/2); a consistent one (the FE cables') by its
+//! Cholesky factor, L⁻¹ K L⁻ᵀ. The dense self-adjoint eigen-solve costs O(n³): it is bounded by
 //! [`crate::linearise::DENSE_MAX_STATES`]. At any size, [`rest_modes_near`] finds the modes
 //! nearest a chosen frequency by shift-invert Lanczos ([`cdpr_numerics::lanczos`]) on the
-//! sparse K − ω_s² M, factorised once by the implicit path's sparse LU.
+//! sparse K − ω_s² M, factorised once by the implicit path's sparse LU (lumped masses only).
 
 use crate::AnalysisError;
 use crate::linearise::DENSE_MAX_STATES;
@@ -44,17 +45,91 @@ pub fn stiffness_and_mass(
     state: &[f64],
     tensions: &[f64],
 ) -> (Mat<f64>, Vec<f64>) {
+    let (k, m) = stiffness_and_mass_matrix(form, state, tensions);
+    let diagonal = (0..m.nrows()).map(|i| m[(i, i)]).collect();
+    (k, diagonal)
+}
+
+/// The dense stiffness K = −∂F/∂q [N/m] and mass M = ∂R/∂q'' [kg] of a second-order form at
+/// rest in `state` under `tensions` [N]: S(c_q = 1) − S(0) and S(0) of its iteration matrix
+/// (q' = 0, q'' = 0, damping off). M is diagonal for lumped masses, full for consistent ones.
+pub fn stiffness_and_mass_matrix(
+    form: &mut dyn SecondOrderForm,
+    state: &[f64],
+    tensions: &[f64],
+) -> (Mat<f64>, Mat<f64>) {
     let n = form.dofs();
     let pattern = form.iteration_pattern();
     let qdd = vec![0.0; n];
     let (mut stiff, mut mass) = (vec![0.0; pattern.len()], vec![0.0; pattern.len()]);
     form.iteration_matrix(state, &qdd, tensions, 0.0, 1.0, &mut stiff);
     form.iteration_matrix(state, &qdd, tensions, 0.0, 0.0, &mut mass);
-    let mut k = Mat::<f64>::zeros(n, n);
+    let (mut k, mut m) = (Mat::<f64>::zeros(n, n), Mat::<f64>::zeros(n, n));
     for (e, &(row, col)) in pattern.iter().enumerate() {
         k[(row, col)] += stiff[e] - mass[e];
+        m[(row, col)] += mass[e];
     }
-    (k, diagonal(&pattern, &mass, n))
+    (k, m)
+}
+
+/// How an eigenvector v of the mass-scaled stiffness becomes the physical shape u (K u = ω² M u,
+/// uᵀ M u = 1): u = M^(−1/2) v for lumped masses, u = L⁻ᵀ v for consistent ones (M = L Lᵀ).
+enum Shapes {
+    Lumped(Vec<f64>),
+    Consistent(Mat<f64>),
+}
+
+impl Shapes {
+    /// The shape u over all `n` coordinates (zero on the frozen ones) of `v` over `keep`.
+    fn physical(&self, n: usize, keep: &[usize], v: Vec<f64>) -> Vec<f64> {
+        let mut u = vec![0.0; n];
+        match self {
+            Shapes::Lumped(m) => {
+                for (row, &i) in keep.iter().enumerate() {
+                    u[i] = v[row] / m[i].sqrt();
+                }
+            }
+            Shapes::Consistent(l) => {
+                let mut x = Mat::from_fn(keep.len(), 1, |r, _| v[r]);
+                faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+                    l.transpose(),
+                    x.as_mut(),
+                    faer::Par::Seq,
+                );
+                for (row, &i) in keep.iter().enumerate() {
+                    u[i] = x[(row, 0)];
+                }
+            }
+        }
+        u
+    }
+}
+
+/// L⁻¹ K L⁻ᵀ over `keep` with M = L Lᵀ (Cholesky: M is positive definite, the kinetic energy of
+/// the free coordinates), and L for the shapes.
+fn consistent(
+    k: &Mat<f64>,
+    mass: &Mat<f64>,
+    keep: &[usize],
+) -> Result<(Mat<f64>, Shapes), AnalysisError> {
+    let restrict =
+        |a: &Mat<f64>| Mat::from_fn(keep.len(), keep.len(), |r, c| a[(keep[r], keep[c])]);
+    let llt = restrict(mass).llt(Side::Lower).map_err(|e| {
+        AnalysisError::Sparse(format!("the mass matrix is not positive definite: {e:?}"))
+    })?;
+    let l = llt.L().to_owned();
+    let solve = |mut x: Mat<f64>| {
+        faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+            l.as_ref(),
+            x.as_mut(),
+            faer::Par::Seq,
+        );
+        x
+    };
+    // L⁻¹ (L⁻¹ Kᵀ)ᵀ = L⁻¹ K L⁻ᵀ.
+    let half = solve(restrict(k).transpose().to_owned());
+    let scaled = solve(half.transpose().to_owned());
+    Ok((scaled, Shapes::Consistent(l)))
 }
 
 /// The diagonal of an n × n matrix given by its `pattern` and entry `values` (duplicates summed).
@@ -86,12 +161,21 @@ pub fn rest_modes<M: CableModel<D>, const D: usize>(
             limit: DENSE_MAX_STATES,
         });
     }
-    let (k, m) = stiffness_and_mass(form, state, tensions);
+    let (k, mass) = stiffness_and_mass_matrix(form, state, tensions);
     let keep: Vec<usize> = (0..n).filter(|i| !layout.frozen.contains(i)).collect();
-    let scaled = Mat::from_fn(keep.len(), keep.len(), |r, c| {
-        let (i, j) = (keep[r], keep[c]);
-        k[(i, j)] / (m[i] * m[j]).sqrt()
-    });
+    let lumped = keep
+        .iter()
+        .all(|&i| keep.iter().all(|&j| i == j || mass[(i, j)] == 0.0));
+    let (scaled, shapes) = if lumped {
+        let m: Vec<f64> = (0..n).map(|i| mass[(i, i)]).collect();
+        let scaled = Mat::from_fn(keep.len(), keep.len(), |r, c| {
+            let (i, j) = (keep[r], keep[c]);
+            k[(i, j)] / (m[i] * m[j]).sqrt()
+        });
+        (scaled, Shapes::Lumped(m))
+    } else {
+        consistent(&k, &mass, &keep)?
+    };
     let mut largest = 0.0f64;
     let mut asymmetry = 0.0f64;
     for r in 0..keep.len() {
@@ -109,9 +193,9 @@ pub fn rest_modes<M: CableModel<D>, const D: usize>(
     let (values, vectors) = (evd.S().column_vector(), evd.U());
     let pairs = (0..keep.len()).map(|e| {
         let shape: Vec<f64> = (0..keep.len()).map(|row| vectors[(row, e)]).collect();
-        (values[e], shape)
+        (values[e], shapes.physical(n, &keep, shape))
     });
-    let (modes, effector_motion) = named(&layout, &keep, &m, pairs);
+    let (modes, effector_motion) = named(&layout, pairs);
     Ok(RestModes {
         modes,
         effector_motion,
@@ -123,13 +207,11 @@ pub fn rest_modes<M: CableModel<D>, const D: usize>(
     })
 }
 
-/// The modes of `pairs` (eigenvalue ω², eigenvector of M^(−1/2) K M^(−1/2) over `keep`), in the
+/// The modes of `pairs` (eigenvalue ω², mass-normalised shape over all coordinates), in the
 /// given order, each classified on `layout` and numbered within its kind, and each one's effector
 /// motion.
 fn named(
     layout: &ModalLayout,
-    keep: &[usize],
-    m: &[f64],
     pairs: impl Iterator<Item = (f64, Vec<f64>)>,
 ) -> (Vec<ClassifiedMode>, Vec<Vec<f64>>) {
     let effector: Vec<usize> = layout
@@ -143,11 +225,8 @@ fn named(
     let mut modes = Vec::new();
     let mut effector_motion = Vec::new();
     let mut counts = std::collections::HashMap::new();
-    let mut u = vec![(0.0, 0.0); m.len()];
     for (value, shape) in pairs {
-        for (row, &i) in keep.iter().enumerate() {
-            u[i] = (shape[row] / m[i].sqrt(), 0.0);
-        }
+        let u: Vec<(f64, f64)> = shape.iter().map(|&x| (x, 0.0)).collect();
         let (kind, purity) = classify(layout, &u);
         effector_motion.push(effector.iter().map(|&k| u[k].0).collect());
         let order = counts.entry(kind).or_insert(0);
@@ -188,11 +267,20 @@ pub fn rest_modes_near<M: CableModel<D>, const D: usize>(
     let (mut shifted, mut mass) = (vec![0.0; pattern.len()], vec![0.0; pattern.len()]);
     form.iteration_matrix(state, &qdd, tensions, 0.0, -1.0 / shift, &mut shifted);
     form.iteration_matrix(state, &qdd, tensions, 0.0, 0.0, &mut mass);
+    let keep: Vec<usize> = (0..n).filter(|i| !layout.frozen.contains(i)).collect();
+    let coupled = pattern.iter().zip(&mass).find(|&(&(row, col), &v)| {
+        row != col
+            && v != 0.0
+            && keep.binary_search(&row).is_ok()
+            && keep.binary_search(&col).is_ok()
+    });
+    if let Some((&(row, col), _)) = coupled {
+        return Err(AnalysisError::ConsistentMass { row, col });
+    }
     let m = diagonal(&pattern, &mass, n);
     let sparse = |e: cdpr_numerics::sparse::SparseError| AnalysisError::Sparse(e.to_string());
     let mut lu = IterationMatrix::new(n, &pattern).map_err(sparse)?;
     lu.factorise(&shifted).map_err(sparse)?;
-    let keep: Vec<usize> = (0..n).filter(|i| !layout.frozen.contains(i)).collect();
     let mut rhs = vec![0.0; n];
     // (A − ω² I)⁻¹ y = M^(1/2) (K − ω² M)⁻¹ M^(1/2) y, and (K − ω² M)⁻¹ = −S⁻¹/ω².
     let solve = |y: &[f64], out: &mut [f64]| {
@@ -208,11 +296,12 @@ pub fn rest_modes_near<M: CableModel<D>, const D: usize>(
     let pairs = cdpr_numerics::lanczos::nearest(keep.len(), shift, count, steps, solve)
         .map_err(|e| AnalysisError::Sparse(e.to_string()))?;
     let residuals = pairs.iter().map(|p| p.residual).collect();
+    let lumped = Shapes::Lumped(m);
     let (modes, effector_motion) = named(
         &layout,
-        &keep,
-        &m,
-        pairs.into_iter().map(|p| (p.value, p.vector)),
+        pairs
+            .into_iter()
+            .map(|p| (p.value, lumped.physical(n, &keep, p.vector))),
     );
     Ok((
         RestModes {
