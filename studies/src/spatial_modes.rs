@@ -3,9 +3,9 @@
 //! geometric stiffness Σ (T_i/l_i)(I − u_i u_iᵀ), MODELS.md §11), with the reels locked
 //! (K = Σ (EA/l_i) u_i u_iᵀ + (T_i/l_i) I), and in the scenario's closed loop (the elastic
 //! model and its controller, linearised by central differences at rest at the pose); for a
-//! scenario on lumped lines also every mode of the lines and the effector with the reels locked,
-//! each named (effector x, y, vertical; each cable's string in and across its vertical plane;
-//! axial). The tensions at rest are the scenario's distribution of the weight there.
+//! scenario on lumped or FE lines also every mode of the lines and the effector with the reels
+//! locked, each named (effector x, y, vertical; each cable's string in and across its vertical
+//! plane; axial). The tensions at rest are the scenario's distribution of the weight there.
 
 use crate::{Result, StudyError};
 use cdpr_bench::analysis::linearise::closed_loop_jacobian;
@@ -30,6 +30,15 @@ pub enum SpatialLoop {
     /// The scenario's lumped lines at rest, reels locked (the firmware's robot between moves):
     /// every mode of the lines and the effector, named.
     LumpedLockedReels,
+    /// The same on the scenario's FE cables (consistent masses, l_i and ρ_i held).
+    FeLockedReels,
+}
+
+/// The massive lines whose locked modes are named, and their elements per line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Lines {
+    Lumped(usize),
+    Fe(usize),
 }
 
 /// One mode.
@@ -94,17 +103,23 @@ pub fn at_pose(scenario: &Scenario, pose: [f64; 3]) -> Result<SpatialModes> {
     let mut modes = open_loop_modes(&robot, &p, &tensions, ea);
     modes.extend(closed_loop_modes(&mut sys, &y, &robot, pose)?);
     let config = cdpr_bench::ModelConfig::from_scenario(scenario)?;
-    if config.kind == cdpr_bench::ModelKind::Lumped && robot.cables() > 2 {
-        let elements = config.lumped().map_err(cdpr_bench::Error::from)?.elements;
+    let lines = match config.kind {
+        cdpr_bench::ModelKind::Lumped => Some(Lines::Lumped(
+            config.lumped().map_err(cdpr_bench::Error::from)?.elements,
+        )),
+        cdpr_bench::ModelKind::Fe => Some(Lines::Fe(
+            config.fe().map_err(cdpr_bench::Error::from)?.elements,
+        )),
+        _ => None,
+    };
+    if let Some(lines) = lines.filter(|_| robot.cables() > 2) {
         let locked = modes
             .iter()
             .filter(|m| m.linearisation == SpatialLoop::LockedReels)
             .map(|m| m.omega_rad_s);
         let (low, high) = locked.fold((f64::INFINITY, 0.0f64), |(l, h), w| (l.min(w), h.max(w)));
         let centre = (low * high).sqrt();
-        modes.extend(lumped_locked_modes(
-            scenario, elements, &p, &tensions, centre,
-        )?);
+        modes.extend(locked_line_modes(scenario, lines, &p, &tensions, centre)?);
     }
     Ok(SpatialModes {
         pose,
@@ -155,37 +170,68 @@ fn open_loop_modes(robot: &Robot<3>, p: &Vector<3>, tensions: &[f64], ea: f64) -
     modes
 }
 
-/// Every mode of the scenario's lumped lines of `elements` springs at rest at `p` [m] under
-/// `tensions` [N], reels then locked, each named (`cdpr_analysis::rest_modes`); beyond the
-/// dense solve's size, the [`SPARSE_MODES`] nearest `centre` [rad/s] (the elastic lines'
-/// locked effector modes), by shift-invert.
-fn lumped_locked_modes(
+/// Every mode of the scenario's massive `lines` at rest at `p` [m] under `tensions` [N], reels
+/// then locked, each named (`cdpr_analysis::rest_modes`); beyond the dense solve's size, the
+/// lumped lines' [`SPARSE_MODES`] nearest `centre` [rad/s] (the elastic lines' locked effector
+/// modes), by shift-invert.
+pub fn locked_line_modes(
     scenario: &Scenario,
-    elements: usize,
+    lines: Lines,
     p: &Vector<3>,
     tensions: &[f64],
     centre: f64,
 ) -> Result<Vec<SpatialMode>> {
+    use cdpr_bench::core::model::{CableModel, PoseRule};
+    let fail =
+        |e: String| StudyError::Failed(format!("{lines:?} modes at {:?} m: {e}", p.as_slice()));
+    let hold = cdpr_bench::core::robot::Tensions::from_slice(tensions);
+    let rule = PoseRule::new(p, hold);
+    match lines {
+        Lines::Lumped(elements) => {
+            let mut model =
+                cdpr_bench::lumped::spatial::LumpedSpatial::from_scenario(scenario, elements)
+                    .map_err(|e| fail(e.to_string()))?;
+            let rest = model.equilibrium(&rule).map_err(|e| fail(e.to_string()))?;
+            model.lock_reels(true);
+            named_modes(
+                &mut model,
+                &rest.state,
+                centre,
+                SpatialLoop::LumpedLockedReels,
+            )
+        }
+        Lines::Fe(elements) => {
+            let mut params = cdpr_bench::ModelConfig::from_scenario(scenario)?
+                .fe()
+                .map_err(cdpr_bench::Error::from)?;
+            params.elements = elements;
+            let mut model = cdpr_bench::fe::spatial::FeSpatial::from_scenario(scenario, params)
+                .map_err(|e| fail(e.to_string()))?;
+            let rest = model.equilibrium(&rule).map_err(|e| fail(e.to_string()))?;
+            model.lock_reels(true);
+            named_modes(&mut model, &rest.state, centre, SpatialLoop::FeLockedReels)
+        }
+    }
+    .map_err(|e| fail(e.to_string()))
+}
+
+/// The named modes of a locked `model` at rest in `rest` (the dense solve, or beyond its size
+/// the sparse one near `centre` [rad/s]), each with its effector direction and share.
+fn named_modes<M: cdpr_bench::core::model::CableModel<3>>(
+    model: &mut M,
+    rest: &[f64],
+    centre: f64,
+    linearisation: SpatialLoop,
+) -> std::result::Result<Vec<SpatialMode>, cdpr_bench::analysis::AnalysisError> {
     use cdpr_bench::analysis::AnalysisError;
     use cdpr_bench::analysis::rest_modes::{rest_modes, rest_modes_near};
-    use cdpr_bench::core::model::{CableModel, PoseRule};
-    let fail = |e: String| StudyError::Failed(format!("lumped modes at {:?} m: {e}", p.as_slice()));
-    let mut model = cdpr_bench::lumped::spatial::LumpedSpatial::from_scenario(scenario, elements)
-        .map_err(|e| fail(e.to_string()))?;
-    let hold = cdpr_bench::core::robot::Tensions::from_slice(tensions);
-    let rest = model
-        .equilibrium(&PoseRule::new(p, hold))
-        .map_err(|e| fail(e.to_string()))?;
-    model.lock_reels(true);
-    let none = vec![0.0; tensions.len()];
-    let named = match rest_modes(&mut model, &rest.state, &none) {
+    let none = vec![0.0; model.robot().cables()];
+    let named = match rest_modes(model, rest, &none) {
         Err(AnalysisError::TooLarge { .. }) => {
-            rest_modes_near(&mut model, &rest.state, &none, (centre, SPARSE_MODES, 80))
-                .map(|(named, _)| named)
+            rest_modes_near(model, rest, &none, (centre, SPARSE_MODES, 80)).map(|(named, _)| named)
         }
         other => other,
-    }
-    .map_err(|e| fail(e.to_string()))?;
+    }?;
     let effector_mass = model.robot().effector_mass;
     Ok(named
         .modes
@@ -196,7 +242,7 @@ fn lumped_locked_modes(
             let direction =
                 std::array::from_fn(|k| if norm > 0.0 { motion[k] / norm } else { 0.0 });
             SpatialMode {
-                linearisation: SpatialLoop::LumpedLockedReels,
+                linearisation,
                 omega_rad_s: m.mode.omega,
                 growth: m.mode.growth,
                 direction,
@@ -263,7 +309,7 @@ fn name(robot: &Robot<3>, direction: [f64; 3]) -> String {
 /// How many modes the sparse solve finds around the effector's when the dense one is too large.
 const SPARSE_MODES: usize = 12;
 
-/// The lumped lines' lowest modes the Markdown table lists (modes.json has them all).
+/// The massive lines' lowest modes the Markdown table lists (modes.json has them all).
 const LUMPED_ROWS: usize = 24;
 
 /// The modes as a Markdown table.
@@ -274,7 +320,10 @@ pub fn markdown(report: &SpatialModes) -> String {
     );
     let mut lumped = 0;
     for m in &report.modes {
-        if m.linearisation == SpatialLoop::LumpedLockedReels {
+        if matches!(
+            m.linearisation,
+            SpatialLoop::LumpedLockedReels | SpatialLoop::FeLockedReels
+        ) {
             lumped += 1;
             if lumped > LUMPED_ROWS {
                 continue;
@@ -295,9 +344,14 @@ pub fn markdown(report: &SpatialModes) -> String {
             frequency repeated (a controller with equal gains on every axis) share their span, \
             so their directions and names are any in it.\n";
     if lumped > LUMPED_ROWS {
+        let fe = report
+            .modes
+            .iter()
+            .any(|m| m.linearisation == SpatialLoop::FeLockedReels);
+        let lines = if fe { "FE cables'" } else { "lumped lines'" };
         out += &format!(
-            "\nThe lumped lines' lowest {LUMPED_ROWS} of {lumped} modes are listed; modes.json \
-             has them all.\n"
+            "\nThe {lines} lowest {LUMPED_ROWS} of {lumped} modes are listed; modes.json has \
+             them all.\n"
         );
     }
     out

@@ -4,10 +4,10 @@
 //! flex compensation against the sagging lines ([`crate::flex_error`]); and the robot's move
 //! under every controller on every cable model ([`leaderboard`]: the leaderboard in 3-D).
 //!
-//! The cable models in space are the massless elastic cables and the lumped lines (MODELS.md
-//! §11); the finite-element cable is planar only, so it has no column here.
+//! The cable models in space are the massless elastic cables, the lumped lines and the FE
+//! cables (MODELS.md §11); the maps' FE columns are FE cables of [`FE_ELEMENTS`] elements.
 
-use crate::spatial_modes::{SpatialLoop, at_pose};
+use crate::spatial_modes::{Lines, SpatialLoop, at_pose, locked_line_modes};
 use crate::spatial_moves::{MoveRow, table_with};
 use crate::{Result, StudyError};
 use cdpr_bench::ModelKind;
@@ -33,10 +33,10 @@ pub struct ModePoint {
     /// locked line is L_i = (N − r_i + 1) l0, up to one spring longer than the chord (MODELS.md
     /// §11). Against this the lumped lines differ by their mass alone.
     pub elastic_same_length_rad_s: f64,
-    /// Lumped lines, the reels locked: the lowest mode that moves the effector — whose share of
-    /// the kinetic energy in the effector is at least [`EFFECTOR_SHARE`] — and that share.
-    /// (Where the effector's mode meets a string's they hybridise and neither is named
-    /// "effector" by its largest share, so a share, not the name, finds it.)
+    /// Lumped lines, the reels locked: the effector's lowest mode ([`effector_mode`]) and its
+    /// share of the kinetic energy in the effector. (Where the effector's mode meets a string's
+    /// they hybridise and neither is named "effector" by its largest share, so shares, not
+    /// the name, find it.)
     pub lumped_locked_rad_s: Option<f64>,
     pub lumped_locked_share: Option<f64>,
     /// Lumped lines, the reels locked: the lowest string mode of any cable, in or across its
@@ -44,18 +44,43 @@ pub struct ModePoint {
     /// `lumped_locked_rad_s` (how much the strings below it move the effector).
     pub lowest_string_rad_s: Option<f64>,
     pub share_below: f64,
+    /// FE cables, the reels locked: the effector's lowest mode ([`effector_mode`]) and its
+    /// share, the elastic lines locked at the FE cables' own
+    /// unstrained lengths l_i (the mass alone), and the lowest string mode.
+    pub fe_locked_rad_s: Option<f64>,
+    pub fe_locked_share: Option<f64>,
+    pub fe_same_length_rad_s: f64,
+    pub fe_lowest_string_rad_s: Option<f64>,
 }
 
-/// A mode of the lumped lines moves the effector when at least this share of its kinetic
-/// energy is the effector's: a string mode of the Hangprinter-like robot has under 0.05, an
-/// effector mode over 0.9, and an effector mode hybridised with one string about 0.4.
-pub const EFFECTOR_SHARE: f64 = 0.25;
+/// The lines' effector mode is the lowest by which the effector's shares of the modes' kinetic
+/// energy, summed from the lowest mode up, reach this: half of one direction's (the shares of
+/// all modes sum to one per axis). On the Hangprinter-like robot a string mode has under 0.05
+/// and the effector's mode over 0.9, picked alone; where strings hybridise with it (CoGiRo's
+/// centre: three modes of 0.22–0.25 each on FE lines) it lands where half the effector's
+/// modal mass does, which a threshold per mode would miss.
+pub const EFFECTOR_SHARE: f64 = 0.5;
+
+/// The effector's lowest mode among `modes` (any order): the lowest by which the summed
+/// effector shares reach [`EFFECTOR_SHARE`].
+pub fn effector_mode<'a>(
+    modes: impl Iterator<Item = &'a crate::spatial_modes::SpatialMode>,
+) -> Option<&'a crate::spatial_modes::SpatialMode> {
+    let mut ascending: Vec<_> = modes.collect();
+    ascending.sort_by(|a, b| a.omega_rad_s.total_cmp(&b.omega_rad_s));
+    let mut sum = 0.0;
+    ascending.into_iter().find(|m| {
+        sum += m.effector_share.unwrap_or(0.0);
+        sum >= EFFECTOR_SHARE
+    })
+}
 
 /// [`mode_map`]'s result.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ModeMap {
-    /// Springs per line of the lumped lines.
+    /// Springs per line of the lumped lines, elements per span of the FE cables.
     pub elements: usize,
+    pub fe_elements: usize,
     /// The box [m] and the points per axis of its grid.
     pub low: [f64; 3],
     pub high: [f64; 3],
@@ -85,6 +110,7 @@ pub fn mode_map(
     let elements = config.lumped().map_err(cdpr_bench::Error::from)?.elements;
     let model = LumpedSpatial::from_scenario(scenario, elements)
         .map_err(|e| StudyError::Failed(format!("the lumped lines: {e}")))?;
+    let fe_scenario = fe_variant(scenario)?;
     let targets = crate::flex_error::grid(low, high, per_axis);
     let rows = crate::pool::map(&targets, |p| -> Result<Option<ModePoint>> {
         let Some(tensions) = crate::flex_error::rest_tensions(scenario, model.robot(), p) else {
@@ -104,10 +130,16 @@ pub fn mode_map(
             .filter(|m| m.linearisation == SpatialLoop::LumpedLockedReels)
             .collect();
         let share = |m: &crate::spatial_modes::SpatialMode| m.effector_share.unwrap_or(0.0);
-        let effector = lumped
-            .iter()
-            .filter(|m| share(m) >= EFFECTOR_SHARE)
-            .min_by(|a, b| a.omega_rad_s.total_cmp(&b.omega_rad_s));
+        let effector = effector_mode(lumped.iter().copied());
+        let fe = locked_line_modes(&fe_scenario, Lines::Fe(FE_ELEMENTS), p, &tensions, 0.0)?;
+        let fe_same_length_rad_s = fe_same_length_lowest(&fe_scenario, p, &tensions)?;
+        let fe_effector = effector_mode(fe.iter());
+        let strings = |modes: &mut dyn Iterator<Item = &crate::spatial_modes::SpatialMode>| {
+            modes
+                .filter(|m| matches!(m.kind, Some(ModeKind::InPlane(_) | ModeKind::OutOfPlane(_))))
+                .map(|m| m.omega_rad_s)
+                .min_by(f64::total_cmp)
+        };
         let share_below = lumped
             .iter()
             .filter(|m| effector.is_some_and(|e| m.omega_rad_s < e.omega_rad_s))
@@ -131,11 +163,16 @@ pub fn mode_map(
                     && matches!(m.kind, Some(ModeKind::InPlane(_) | ModeKind::OutOfPlane(_)))
             }),
             share_below,
+            fe_locked_rad_s: fe_effector.map(|m| m.omega_rad_s),
+            fe_locked_share: fe_effector.map(|m| share(m)),
+            fe_same_length_rad_s,
+            fe_lowest_string_rad_s: strings(&mut fe.iter()),
         }))
     })?;
     let (points, infeasible) = crate::flex_error::feasible(rows)?;
     Ok(ModeMap {
         elements,
+        fe_elements: FE_ELEMENTS,
         low,
         high,
         per_axis,
@@ -170,6 +207,47 @@ fn same_length_lowest(model: &LumpedSpatial, p: &Vector<3>, tensions: &[f64]) ->
     Ok(lowest.max(0.0).sqrt())
 }
 
+/// `scenario` on FE cables of [`FE_ELEMENTS`] elements.
+fn fe_variant(scenario: &Scenario) -> Result<Scenario> {
+    let mut config = cdpr_bench::ModelConfig::from_scenario(scenario)?;
+    config.kind = ModelKind::Fe;
+    config.elements = Some(FE_ELEMENTS as i64);
+    let mut s = scenario.clone();
+    s.model = config.section();
+    cdpr_bench::validate(&s)?;
+    Ok(s)
+}
+
+/// The lowest effector mode [rad/s] on massless elastic lines locked at the unstrained lengths
+/// l_i the FE cables of `scenario` take at rest at `p` under `tensions` [N]: K = Σ (EA/l_i) u_i
+/// u_iᵀ + (T_i/d_i)(I − u_i u_iᵀ), d_i the chord, T_i the FE line's tension at the effector.
+fn fe_same_length_lowest(scenario: &Scenario, p: &Vector<3>, tensions: &[f64]) -> Result<f64> {
+    let fail =
+        |e: String| StudyError::Failed(format!("FE lines at rest at {:?} m: {e}", p.as_slice()));
+    let params = cdpr_bench::ModelConfig::from_scenario(scenario)?
+        .fe()
+        .map_err(cdpr_bench::Error::from)?;
+    let mut model = cdpr_bench::fe::spatial::FeSpatial::from_scenario(scenario, params)
+        .map_err(|e| fail(e.to_string()))?;
+    let rest = model
+        .equilibrium(&PoseRule::new(p, Tensions::from_slice(tensions)))
+        .map_err(|e| fail(e.to_string()))?
+        .state;
+    let mut k = Matrix::<3>::zeros();
+    for c in 0..model.robot().cables() {
+        let d = model.pulley(c) - p;
+        let (chord, u) = (d.norm(), d.normalize());
+        let uu = u * u.transpose();
+        let t = model.element_tension(&rest, c, model.elements);
+        let l = model.free_length(&rest, c);
+        k += uu * (model.material.ea / l) + (Matrix::<3>::identity() - uu) * (t / chord);
+    }
+    let lowest = (k / model.robot().effector_mass)
+        .symmetric_eigenvalues()
+        .min();
+    Ok(lowest.max(0.0).sqrt())
+}
+
 /// "min … max" of `values` [rad/s] in Hz, "—" when there are none.
 fn hz_range(values: impl Iterator<Item = Option<f64>>) -> String {
     let hz: Vec<f64> = values
@@ -195,20 +273,24 @@ pub fn mode_markdown(map: &ModeMap) -> String {
     let mut out = format!(
         "Lowest modes over {} targets ({} outside the wrench-feasible workspace), lumped lines of \
          {} springs, reels locked unless said [Hz, least … largest over the height's targets]. \
-         The lumped lines' effector mode is their lowest with at least {EFFECTOR_SHARE} of its \
-         kinetic energy in the effector; it is compared with the elastic lines locked at the \
-         chord and at the lumped lines' own locked length (the mass alone):\n\n\
+         The lines' effector mode is their lowest by which the effector's shares of the modes' \
+         kinetic energy, summed from the lowest up, reach {EFFECTOR_SHARE}; it is compared with the elastic lines locked at the \
+         chord and at the lumped lines' own locked length (the mass alone); the FE cables' \
+         ({} elements, consistent masses) likewise, with the elastic lines at their unstrained \
+         lengths:\n\n\
          | z [m] | elastic, tension reels | elastic, locked | lumped, locked | lumped / elastic \
-         | lumped / elastic at its length | lowest string mode | largest effector share below |\n\
-         |---|---|---|---|---|---|---|---|\n",
+         | lumped / elastic at its length | lowest string mode | largest effector share below \
+         | FE, locked | FE / elastic at its length | FE lowest string mode |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
         map.points.len(),
         map.infeasible,
-        map.elements
+        map.elements,
+        map.fe_elements
     );
     for z in heights {
         let here: Vec<&ModePoint> = map.points.iter().filter(|p| p.pose[2] == z).collect();
         out += &format!(
-            "| {z:.3} | {} | {} | {} | {} | {} | {} | {:.3} |\n",
+            "| {z:.3} | {} | {} | {} | {} | {} | {} | {:.3} | {} | {} | {} |\n",
             hz_range(here.iter().map(|p| Some(p.elastic_tension_reels_rad_s))),
             hz_range(here.iter().map(|p| Some(p.elastic_locked_rad_s))),
             hz_range(here.iter().map(|p| p.lumped_locked_rad_s)),
@@ -222,6 +304,12 @@ pub fn mode_markdown(map: &ModeMap) -> String {
             ),
             hz_range(here.iter().map(|p| p.lowest_string_rad_s)),
             here.iter().map(|p| p.share_below).fold(0.0, f64::max),
+            hz_range(here.iter().map(|p| p.fe_locked_rad_s)),
+            ratio_range(
+                here.iter()
+                    .map(|p| (p.fe_locked_rad_s, p.fe_same_length_rad_s))
+            ),
+            hz_range(here.iter().map(|p| p.fe_lowest_string_rad_s)),
         );
     }
     out
@@ -259,13 +347,7 @@ pub fn leaderboard(scenario: &Scenario) -> Result<Vec<ModelMoves>> {
         let s = if cdpr_bench::ModelConfig::from_scenario(scenario)?.kind == kind {
             scenario.clone()
         } else if kind == ModelKind::Fe {
-            let mut config = cdpr_bench::ModelConfig::from_scenario(scenario)?;
-            config.kind = kind;
-            config.elements = Some(FE_ELEMENTS as i64);
-            let mut s = scenario.clone();
-            s.model = config.section();
-            cdpr_bench::validate(&s)?;
-            s
+            fe_variant(scenario)?
         } else {
             cdpr_bench::with_model_kind(scenario, kind)?
         };

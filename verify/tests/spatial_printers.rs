@@ -105,7 +105,9 @@ proptest! {
     /// - the effector's lowest mode on the lumped lines lies at or below the massless elastic
     ///   lines' locked at the same lengths (1e-6 for round-off) and within 0.5 % of it: by
     ///   Rayleigh, a line adds about a third of its mass (≤ 1.5 g of 2.3 m of 0.92 g/m line)
-    ///   to the 1 kg effector along its own direction, so the frequency falls by ≲ 0.1 %.
+    ///   to the 1 kg effector along its own direction, so the frequency falls by ≲ 0.1 %;
+    /// - so does the FE cables' (N = 10, consistent masses) against the elastic lines locked at
+    ///   their unstrained lengths l_i.
     #[test]
     fn shares_are_complete_and_the_mass_alone_lowers_the_effectors_mode(
         x in -0.3f64..0.3, y in -0.3f64..0.3, z in 0.0f64..0.6, fine in any::<bool>(),
@@ -124,5 +126,7 @@ proptest! {
         let p = &map.points[0];
         let ratio = p.lumped_locked_rad_s.unwrap() / p.elastic_same_length_rad_s;
         prop_assert!((0.995..=1.0 + 1e-6).contains(&ratio), "lumped / elastic {ratio} at {pose:?}");
+        let fe = p.fe_locked_rad_s.unwrap() / p.fe_same_length_rad_s;
+        prop_assert!((0.995..=1.0 + 1e-6).contains(&fe), "FE / elastic {fe} at {pose:?}");
     }
 }

@@ -316,7 +316,11 @@ impl FeSpatial {
         // The (l_i, ρ_i) pairs are the last coordinates.
         let first = self.l_index(0);
         for (e, &(row, col)) in pattern.iter().enumerate().filter(|(_, rc)| rc.0 >= first) {
-            let diagonal = if (row - first).is_multiple_of(2) { held } else { 1.0 };
+            let diagonal = if (row - first).is_multiple_of(2) {
+                held
+            } else {
+                1.0
+            };
             values[e] = if col == row { diagonal } else { 0.0 };
         }
         self.system = sys;

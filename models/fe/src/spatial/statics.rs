@@ -1,8 +1,8 @@
 //! Statics of the spatial FE robot (MODELS.md FE.8.1 at a pose, §11): F(q, 0, T) = 0 with the
 //! effector pinned at the rule's pose and the cables' weight carried by a tension correction
 //! T = T0 + W⁺ δw (the least in the tensions' norm, as the lumped lines'), by the core's Newton
-//! service from the straight-chord guess (nodes on the chords A_i → P, l_i = chord/(1 + T_i/EA),
-//! ρ_i = (L0 − l_i)(1 + T_i/EA)).
+//! service from the sagging guess: nodes on each chord A_i → P lowered by the parabola of the
+//! span's weight, l_i its arc over (1 + T_i/EA), ρ_i = (L0 − l_i)(1 + T_i/EA).
 //!
 //! Unknowns: every coordinate of q but the effector's three, then δw (3); equations: every row
 //! of F. The Jacobian is the Newton service's dense central differences: O(n³) per iteration,
@@ -104,7 +104,7 @@ pub(super) fn equilibrium(
         t: 0.0,
         why: format!("the cables do not span space at {:?} m", pose.as_slice()),
     })?;
-    let y = straight_guess(model, &pose, &base)?;
+    let y = sagging_guess(model, &pose, &base)?;
     let np = model.positions_len();
     let effector: Vec<usize> = (0..3).map(|a| model.effector_index(a)).collect();
     let map: Vec<usize> = (0..np).filter(|i| !effector.contains(i)).collect();
@@ -132,8 +132,13 @@ pub(super) fn equilibrium(
     })
 }
 
-/// Nodes on the chords, each span's and stored element's strain that of its tension.
-fn straight_guess(
+/// Nodes on the chords lowered by the parabolic sag of the span's weight μ g under the
+/// horizontal pull H = T_i d_h/d (d the chord, d_h its horizontal part): at ξ along it,
+/// μ g d_h²/(2H) ξ(1 − ξ) = μ g d_h d/(2T_i) ξ(1 − ξ) — nought for a plumb line, at most a
+/// quarter of the chord — and l_i N times the shortest element's length over the strain of its
+/// tension, so that no element starts slack. Heavy lines (CoGiRo's 15 m of steel) do not converge from the
+/// straight chords.
+fn sagging_guess(
     model: &FeSpatial,
     pose: &Vector3<f64>,
     tensions: &Tensions,
@@ -143,16 +148,31 @@ fn straight_guess(
     for a in 0..3 {
         y[model.effector_index(a)] = pose[a];
     }
+    let weight = model.material.mu * model.material.gravity;
     for cable in 0..model.robot().cables() {
         let a = model.pulley(cable);
-        for k in 1..n {
-            let p = a + (pose - a) * (k as f64 / n as f64);
-            for axis in 0..3 {
-                y[model.node_index(cable, k, axis)] = p[axis];
+        let chord = pose - a;
+        let d = chord.norm();
+        let pull = tensions[cable].max(f64::MIN_POSITIVE);
+        let mid = (weight * chord.xy().norm() * d / (8.0 * pull)).min(0.0625 * d);
+        let node = |k: usize| {
+            let xi = k as f64 / n as f64;
+            let mut p = a + chord * xi;
+            p.z -= 4.0 * mid * xi * (1.0 - xi);
+            p
+        };
+        let mut shortest = f64::INFINITY;
+        for k in 1..=n {
+            let p = node(k);
+            shortest = shortest.min((p - node(k - 1)).norm());
+            if k < n {
+                for axis in 0..3 {
+                    y[model.node_index(cable, k, axis)] = p[axis];
+                }
             }
         }
         let stretch = 1.0 + tensions[cable].max(0.0) / model.material.ea;
-        let l = (pose - a).norm() / stretch;
+        let l = n as f64 * shortest / stretch;
         if l >= model.modelled_length {
             return Err(ModelError::Parameter {
                 name: "cable.modelled_length",
