@@ -157,14 +157,14 @@ pub fn mode_map(
                 .ok_or_else(|| missing("locked-reel"))?,
             elastic_same_length_rad_s: same_length,
             lumped_locked_rad_s: effector.map(|m| m.omega_rad_s),
-            lumped_locked_share: effector.map(|m| share(m)),
+            lumped_locked_share: effector.map(share),
             lowest_string_rad_s: lowest(&|m| {
                 m.linearisation == SpatialLoop::LumpedLockedReels
                     && matches!(m.kind, Some(ModeKind::InPlane(_) | ModeKind::OutOfPlane(_)))
             }),
             share_below,
             fe_locked_rad_s: fe_effector.map(|m| m.omega_rad_s),
-            fe_locked_share: fe_effector.map(|m| share(m)),
+            fe_locked_share: fe_effector.map(share),
             fe_same_length_rad_s,
             fe_lowest_string_rad_s: strings(&mut fe.iter()),
         }))
