@@ -59,6 +59,14 @@ pub trait StaticProblem {
     fn jacobian(&mut self, _unknowns: &[f64], _values: &mut [f64]) -> bool {
         false
     }
+
+    /// Indices i (row i, unknown i) the sparse LU may also eliminate through its dense border
+    /// ([`IterationMatrix::with_coupled`]): where the rows and unknowns that couple the chains
+    /// are not each other's partners, an interior without them can be structurally singular
+    /// although the whole is not (the spatial FE's δw columns reach only the reel rows).
+    fn coupled(&self) -> Vec<usize> {
+        Vec::new()
+    }
 }
 
 /// The Newton direction's linear algebra: a dense LU of the full finite-difference Jacobian, or
@@ -86,7 +94,9 @@ impl Linear {
         Some(match problem.pattern() {
             Some(pattern) => Self::Sparse {
                 differences: None,
-                matrix: Box::new(IterationMatrix::new(n, &pattern).ok()?),
+                matrix: Box::new(
+                    IterationMatrix::with_coupled(n, &pattern, &problem.coupled()).ok()?,
+                ),
                 values: vec![0.0; pattern.len()],
                 steps: (0..n).map(|j| CBRT_EPSILON * problem.scale(j)).collect(),
                 pattern,

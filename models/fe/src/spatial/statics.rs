@@ -5,18 +5,17 @@
 //! span's weight, l_i its arc over (1 + T_i/EA), ρ_i = (L0 − l_i)(1 + T_i/EA).
 //!
 //! Unknowns: every coordinate of q but the effector's three, then δw (3); equations: every row
-//! of F. The Jacobian is the Newton service's dense central differences: O(n³) per iteration,
-//! so the statics is bounded (N ≤ [`MAX_STATIC_ELEMENTS`] per cable).
+//! of F. The Jacobian is sparse — the element blocks' ∂F/∂q (as the implicit path's, at rest)
+//! over the model's pattern, and the exact δw columns in the ρ rows (F is affine in the
+//! tensions) — and is solved by the sparse LU: O(N m) per iteration at any N.
 
 use super::FeSpatial;
 use cdpr_core::model::{CableModel, Equilibrium, ModelError, RestRule};
 use cdpr_core::robot::{Matrix, PerCable, StructureMatrix, Tensions, Vector};
+use cdpr_core::second_order::SecondOrderForm;
+use cdpr_core::statics::{self, StaticPattern};
 use cdpr_numerics::newton::{self, NewtonOptions, StaticProblem};
 use nalgebra::Vector3;
-
-/// Most elements per cable the dense statics takes (n ≈ 24 N m coordinates: N = 60, m = 8 is
-/// 1 400 unknowns, a few seconds).
-pub const MAX_STATIC_ELEMENTS: usize = 60;
 
 struct Problem<'a> {
     model: &'a mut FeSpatial,
@@ -29,6 +28,12 @@ struct Problem<'a> {
     forces: Vec<f64>,
     /// Indices in q of the unknown coordinates, in order (δw follows).
     map: Vec<usize>,
+    /// The Jacobian's pattern (the model's over the unknowns, then δw's columns axis by axis
+    /// in the ρ rows), ∂R/∂q's scratch and q'' = 0.
+    pattern: StaticPattern,
+    rho_rows: Vec<usize>,
+    stiffness: Vec<f64>,
+    at_rest: Vec<f64>,
 }
 
 impl Problem<'_> {
@@ -70,6 +75,38 @@ impl StaticProblem for Problem<'_> {
         r.copy_from_slice(&forces);
         self.forces = forces;
     }
+    fn pattern(&self) -> Option<Vec<(usize, usize)>> {
+        Some(self.pattern.entries.clone())
+    }
+    fn residual_round_off(&self) -> f64 {
+        self.model.residual_round_off(&self.y)
+    }
+    /// The hub: the effector's rows (whose unknowns are δw's), the l_i and ρ_i rows and
+    /// unknowns. Left in the interior with the l_i in the border (dense at N ≳ 11), the ρ rows
+    /// alone would have to carry δw's columns and their own.
+    fn coupled(&self) -> Vec<usize> {
+        (self.model.effector_index(0)..self.map.len() + 3).collect()
+    }
+    /// Element by element (the blocks' ∂R/∂q at rest, sign changed: the residual is F), then
+    /// δw's columns: ∂T_i/∂δw = (W⁺)ᵀ's row i, (WᵀW)⁻¹ w_i, in the ρ_i rows.
+    fn jacobian(&mut self, u: &[f64], values: &mut [f64]) -> bool {
+        self.load(u);
+        let mut stiffness = std::mem::take(&mut self.stiffness);
+        self.model
+            .block_matrix(&self.y, &self.at_rest, [1.0, 0.0, 0.0], &mut stiffness);
+        let (kept, columns) = values.split_at_mut(self.pattern.kept.len());
+        for (value, &p) in kept.iter_mut().zip(&self.pattern.kept) {
+            *value = -stiffness[p];
+        }
+        self.stiffness = stiffness;
+        let m = self.rho_rows.len();
+        for (a, column) in columns.chunks_mut(m).enumerate() {
+            for (i, value) in column.iter_mut().enumerate() {
+                *value = (self.gram_inv * self.w.column(i))[a];
+            }
+        }
+        true
+    }
 }
 
 /// The robot at rest at the rule's pose (every coordinate pinned), the tensions corrected by
@@ -82,16 +119,6 @@ pub(super) fn equilibrium(
         return Err(ModelError::State {
             t: 0.0,
             why: "the spatial FE model rests at a pose: all three coordinates pinned".into(),
-        });
-    }
-    if model.elements > MAX_STATIC_ELEMENTS {
-        return Err(ModelError::Parameter {
-            name: "model.elements",
-            value: model.elements as f64,
-            allowed: format!(
-                "≤ {MAX_STATIC_ELEMENTS} for the spatial FE cables (their statics is dense so \
-                 far)"
-            ),
         });
     }
     let mut pose = Vector3::zeros();
@@ -110,7 +137,28 @@ pub(super) fn equilibrium(
     let map: Vec<usize> = (0..np).filter(|i| !effector.contains(i)).collect();
     let mut u: Vec<f64> = map.iter().map(|&i| y[i]).collect();
     u.extend([0.0; 3]);
+    let first = model.effector_index(0);
+    let force = map.len();
+    let rho_rows = model.tension_rows();
+    let mut pattern = statics::pattern_from_dynamics(
+        &model.iteration_pattern(),
+        Some,
+        |j| match j {
+            _ if j < first => Some(j),
+            _ if j < first + 3 => None,
+            _ => Some(j - 3),
+        },
+        &rho_rows,
+        force,
+    );
+    for axis in 1..3 {
+        pattern
+            .entries
+            .extend(rho_rows.iter().map(|&row| (row, force + axis)));
+    }
     let mut problem = Problem {
+        stiffness: vec![0.0; model.iteration_pattern().len()],
+        at_rest: vec![0.0; np],
         model,
         pose,
         base,
@@ -119,6 +167,8 @@ pub(super) fn equilibrium(
         y,
         forces: vec![0.0; np],
         map,
+        pattern,
+        rho_rows,
     };
     let report = newton::solve(&mut problem, &mut u, NewtonOptions::default())?;
     problem.load(&u);
