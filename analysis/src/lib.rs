@@ -41,12 +41,6 @@ pub enum AnalysisError {
     /// Lanczos iteration).
     #[error("sparse eigen-solve near the shift: {0}")]
     Sparse(String),
-    /// The sparse shift-invert solve takes lumped (diagonal) masses; this model's couples two
-    /// free coordinates (a consistent mass matrix): the dense solve takes it.
-    #[error(
-        "the mass matrix couples coordinates {row} and {col} (consistent masses): the sparse shift-invert solve takes lumped masses only, the dense rest_modes any"
-    )]
-    ConsistentMass { row: usize, col: usize },
     /// The model offers no second-order form to read its mass and stiffness from.
     #[error("the model offers no second-order form (mass and stiffness matrices)")]
     NoSecondOrder,

@@ -268,41 +268,80 @@ pub fn rest_modes_near<M: CableModel<D>, const D: usize>(
     form.iteration_matrix(state, &qdd, tensions, 0.0, -1.0 / shift, &mut shifted);
     form.iteration_matrix(state, &qdd, tensions, 0.0, 0.0, &mut mass);
     let keep: Vec<usize> = (0..n).filter(|i| !layout.frozen.contains(i)).collect();
-    let coupled = pattern.iter().zip(&mass).find(|&(&(row, col), &v)| {
-        row != col
-            && v != 0.0
-            && keep.binary_search(&row).is_ok()
-            && keep.binary_search(&col).is_ok()
-    });
-    if let Some((&(row, col), _)) = coupled {
-        return Err(AnalysisError::ConsistentMass { row, col });
-    }
-    let m = diagonal(&pattern, &mass, n);
     let sparse = |e: cdpr_numerics::sparse::SparseError| AnalysisError::Sparse(e.to_string());
     let mut lu = IterationMatrix::new(n, &pattern).map_err(sparse)?;
     lu.factorise(&shifted).map_err(sparse)?;
+    let lanczos = |e: cdpr_numerics::lanczos::LanczosError| AnalysisError::Sparse(e.to_string());
+    // M over the free coordinates, entry by entry (local row, local col, value).
+    let local: Vec<Option<usize>> = (0..n).map(|i| keep.binary_search(&i).ok()).collect();
+    let free_mass: Vec<(usize, usize, f64)> = pattern
+        .iter()
+        .zip(&mass)
+        .filter_map(|(&(row, col), &v)| Some((local[row]?, local[col]?, v)))
+        .collect();
     let mut rhs = vec![0.0; n];
-    // (A − ω² I)⁻¹ y = M^(1/2) (K − ω² M)⁻¹ M^(1/2) y, and (K − ω² M)⁻¹ = −S⁻¹/ω².
-    let solve = |y: &[f64], out: &mut [f64]| {
-        rhs.fill(0.0);
-        for (row, &i) in keep.iter().enumerate() {
-            rhs[i] = m[i].sqrt() * y[row];
-        }
-        lu.solve_in_place(&mut rhs);
-        for (row, &i) in keep.iter().enumerate() {
-            out[row] = -m[i].sqrt() * rhs[i] / shift;
-        }
-    };
-    let pairs = cdpr_numerics::lanczos::nearest(keep.len(), shift, count, steps, solve)
-        .map_err(|e| AnalysisError::Sparse(e.to_string()))?;
-    let residuals = pairs.iter().map(|p| p.residual).collect();
-    let lumped = Shapes::Lumped(m);
-    let (modes, effector_motion) = named(
-        &layout,
+    let pairs = if free_mass.iter().all(|&(r, c, v)| r == c || v == 0.0) {
+        let m = diagonal(&pattern, &mass, n);
+        // (A − ω² I)⁻¹ y = M^(1/2) (K − ω² M)⁻¹ M^(1/2) y, and (K − ω² M)⁻¹ = −S⁻¹/ω².
+        let solve = |y: &[f64], out: &mut [f64]| {
+            rhs.fill(0.0);
+            for (row, &i) in keep.iter().enumerate() {
+                rhs[i] = m[i].sqrt() * y[row];
+            }
+            lu.solve_in_place(&mut rhs);
+            for (row, &i) in keep.iter().enumerate() {
+                out[row] = -m[i].sqrt() * rhs[i] / shift;
+            }
+        };
+        let pairs = cdpr_numerics::lanczos::nearest(keep.len(), shift, count, steps, solve)
+            .map_err(lanczos)?;
+        let lumped = Shapes::Lumped(m);
         pairs
             .into_iter()
-            .map(|p| (p.value, lumped.physical(n, &keep, p.vector))),
-    );
+            .map(|p| (p.value, lumped.physical(n, &keep, p.vector), p.residual))
+            .collect::<Vec<_>>()
+    } else {
+        // A consistent M: B = (K − ω² M)⁻¹ M in the M inner product, vectors M-normalised.
+        let product = |v: &[f64], out: &mut [f64]| {
+            out.fill(0.0);
+            for &(r, c, value) in &free_mass {
+                out[r] += value * v[c];
+            }
+        };
+        let mut my = vec![0.0; keep.len()];
+        let solve = |y: &[f64], out: &mut [f64]| {
+            product(y, &mut my);
+            rhs.fill(0.0);
+            for (row, &i) in keep.iter().enumerate() {
+                rhs[i] = my[row];
+            }
+            lu.solve_in_place(&mut rhs);
+            for (row, &i) in keep.iter().enumerate() {
+                out[row] = -rhs[i] / shift;
+            }
+        };
+        let pairs = cdpr_numerics::lanczos::nearest_with_mass(
+            keep.len(),
+            shift,
+            count,
+            steps,
+            solve,
+            product,
+        )
+        .map_err(lanczos)?;
+        pairs
+            .into_iter()
+            .map(|p| {
+                let mut u = vec![0.0; n];
+                for (row, &i) in keep.iter().enumerate() {
+                    u[i] = p.vector[row];
+                }
+                (p.value, u, p.residual)
+            })
+            .collect()
+    };
+    let residuals = pairs.iter().map(|p| p.2).collect();
+    let (modes, effector_motion) = named(&layout, pairs.into_iter().map(|(v, u, _)| (v, u)));
     Ok((
         RestModes {
             modes,

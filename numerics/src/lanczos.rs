@@ -39,37 +39,63 @@ pub fn nearest(
     shift: f64,
     count: usize,
     steps: usize,
+    solve: impl FnMut(&[f64], &mut [f64]),
+) -> Result<Vec<RitzPair>, LanczosError> {
+    nearest_with_mass(n, shift, count, steps, solve, |v, out| {
+        out.copy_from_slice(v)
+    })
+}
+
+/// The generalised problem K x = λ M x (K symmetric, M symmetric positive definite) by the same
+/// iteration in the M inner product ⟨a, b⟩ = aᵀ M b, in which B = (K − σ M)⁻¹ M is
+/// self-adjoint (Ericsson & Ruhe 1980): `solve` writes B y, `mass` writes M v. Each basis
+/// vector keeps its M v, so the reorthogonalisation costs O(n k²) as in the standard case. The
+/// vectors come M-normalised (xᵀ M x = 1); with M = I this is [`nearest`] to the bit.
+pub fn nearest_with_mass(
+    n: usize,
+    shift: f64,
+    count: usize,
+    steps: usize,
     mut solve: impl FnMut(&[f64], &mut [f64]),
+    mut mass: impl FnMut(&[f64], &mut [f64]),
 ) -> Result<Vec<RitzPair>, LanczosError> {
     if count == 0 || count > n {
         return Err(LanczosError::Count { count, n });
     }
     let steps = steps.clamp(count, n);
-    let mut basis: Vec<Vec<f64>> = Vec::with_capacity(steps + 1);
+    let (mut basis, mut products): (Vec<Vec<f64>>, Vec<Vec<f64>>) =
+        (Vec::with_capacity(steps + 1), Vec::with_capacity(steps + 1));
     let mut start: Vec<f64> = (0..n)
         .map(|i| ((i as f64 + 1.0) * 0.618_033_988_749_894_9).fract() - 0.5)
         .collect();
-    normalise(&mut start);
+    let mut product = vec![0.0; n];
+    mass(&start, &mut product);
+    let norm = dot(&start, &product).sqrt();
+    start.iter_mut().for_each(|x| *x /= norm);
+    product.iter_mut().for_each(|x| *x /= norm);
     basis.push(start);
+    products.push(product);
     let (mut alpha, mut beta) = (Vec::with_capacity(steps), Vec::with_capacity(steps));
-    let mut w = vec![0.0; n];
+    let (mut w, mut mw) = (vec![0.0; n], vec![0.0; n]);
     for k in 0..steps {
         solve(&basis[k], &mut w);
-        let a = dot(&w, &basis[k]);
+        let a = dot(&w, &products[k]);
         alpha.push(a);
         // Full reorthogonalisation, twice (Kahan's "twice is enough").
         for _ in 0..2 {
-            for v in &basis {
-                let c = dot(&w, v);
+            for (v, mv) in basis.iter().zip(&products) {
+                let c = dot(&w, mv);
                 w.iter_mut().zip(v).for_each(|(w, v)| *w -= c * v);
             }
         }
-        let b = dot(&w, &w).sqrt();
+        mass(&w, &mut mw);
+        let b = dot(&w, &mw).sqrt();
         beta.push(b);
         if b <= 1e-14 * a.abs().max(f64::MIN_POSITIVE) || k + 1 == steps {
             break;
         }
         basis.push(w.iter().map(|v| v / b).collect());
+        products.push(mw.iter().map(|v| v / b).collect());
     }
     let k = alpha.len();
     let tridiagonal = Mat::from_fn(k, k, |i, j| {
@@ -99,7 +125,9 @@ pub fn nearest(
                 let c = s[(i, j)];
                 vector.iter_mut().zip(v).for_each(|(x, v)| *x += c * v);
             }
-            normalise(&mut vector);
+            mass(&vector, &mut mw);
+            let norm = dot(&vector, &mw).sqrt();
+            vector.iter_mut().for_each(|x| *x /= norm);
             RitzPair {
                 value: shift + 1.0 / theta[j],
                 vector,
@@ -113,11 +141,6 @@ pub fn nearest(
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(a, b)| a * b).sum()
-}
-
-fn normalise(v: &mut [f64]) {
-    let norm = dot(v, v).sqrt();
-    v.iter_mut().for_each(|x| *x /= norm);
 }
 
 #[cfg(test)]
@@ -156,6 +179,59 @@ mod tests {
         nearest4.sort_by(f64::total_cmp);
         for (p, e) in pairs.iter().zip(&nearest4) {
             assert!((p.value - e).abs() <= 1e-10, "{} against {e}", p.value);
+        }
+    }
+
+    /// The consistent-mass string, K = tridiag(−1, 2, −1), M = tridiag(1, 4, 1)/6, has
+    /// λ_j = 6 (1 − cos θ_j)/(2 + cos θ_j), θ_j = jπ/(n + 1): the four nearest 1.0 of n = 400 in
+    /// the M inner product, by solves with the dense LU of K − σM, each vector M-normalised.
+    #[test]
+    fn the_consistent_strings_eigenvalues_nearest_a_shift() {
+        let n = 400;
+        let shift = 1.0;
+        let tridiagonal = |d: f64, o: f64| {
+            Mat::from_fn(n, n, |i, j| {
+                if i == j {
+                    d
+                } else if i.abs_diff(j) == 1 {
+                    o
+                } else {
+                    0.0
+                }
+            })
+        };
+        let (k, m) = (tridiagonal(2.0, -1.0), tridiagonal(4.0 / 6.0, 1.0 / 6.0));
+        let lu = (&k - &m * shift).partial_piv_lu();
+        let product = |v: &[f64], out: &mut [f64]| {
+            for i in 0..n {
+                out[i] = (0..n).map(|j| m[(i, j)] * v[j]).sum();
+            }
+        };
+        let solve = |y: &[f64], out: &mut [f64]| {
+            let mut my = vec![0.0; n];
+            product(y, &mut my);
+            let rhs = Mat::from_fn(n, 1, |i, _| my[i]);
+            let x = faer::linalg::solvers::Solve::solve(&lu, &rhs);
+            for i in 0..n {
+                out[i] = x[(i, 0)];
+            }
+        };
+        let pairs = nearest_with_mass(n, shift, 4, 80, solve, product).unwrap();
+        let mut exact: Vec<f64> = (1..=n)
+            .map(|j| {
+                let c = (j as f64 * std::f64::consts::PI / (n as f64 + 1.0)).cos();
+                6.0 * (1.0 - c) / (2.0 + c)
+            })
+            .collect();
+        exact.sort_by(|a, b| (a - shift).abs().total_cmp(&(b - shift).abs()));
+        let mut nearest4 = exact[..4].to_vec();
+        nearest4.sort_by(f64::total_cmp);
+        for (p, e) in pairs.iter().zip(&nearest4) {
+            assert!((p.value - e).abs() <= 1e-10, "{} against {e}", p.value);
+            let mut mx = vec![0.0; n];
+            product(&p.vector, &mut mx);
+            let norm: f64 = p.vector.iter().zip(&mx).map(|(a, b)| a * b).sum();
+            assert!((norm - 1.0).abs() <= 1e-12, "xᵀ M x = {norm}");
         }
     }
 }
