@@ -1,9 +1,8 @@
 //! Cost of the variable-length FE cables in space (MODELS.md §5 along each cable, §11): one
-//! right-hand side of the Hangprinter example at rest on FE cables of N = 10, 20, 40, 60
-//! elements (the star solve is O(N m): the cost per element should stay flat; the dense statics
-//! that starts it stops at N = 60), and the
-//! example's 1.2 s move on DOPRI5 and 5 s on the implicit path at N = 10 (integration only;
-//! steps and RHS printed once).
+//! right-hand side of the Hangprinter example at rest on FE cables of N = 10 … 1000 elements
+//! (the star solve is O(N m): the cost per element should stay flat), the example's 1.2 s move
+//! on DOPRI5 and 5 s on the implicit path at N = 10, and the implicit path's cost against N
+//! (10 … 1000, 0.5 s) to show it O(N m) (integration only; steps and RHS printed once).
 
 use cdpr_bench::core::closed_loop::ClosedLoop;
 use cdpr_bench::core::model::CableModel;
@@ -37,7 +36,7 @@ fn model(s: &Scenario, elements: usize) -> FeSpatial {
 
 fn rhs(c: &mut Criterion) {
     let mut group = c.benchmark_group("fe_spatial/rhs");
-    for n in [10, 20, 40, 60] {
+    for n in [10, 20, 40, 60, 1000] {
         let s = hangprinter(n);
         let mut sys = ClosedLoop::new(model(&s, n), &s).unwrap();
         let (y, _) = sys.initial_state().unwrap();
@@ -87,5 +86,27 @@ fn run(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, rhs, run);
+fn scaling(c: &mut Criterion) {
+    let mut group = c.benchmark_group("fe_spatial/implicit_0.5s_vs_n");
+    group.sample_size(10);
+    for n in [10, 100, 1000] {
+        let mut s = hangprinter(n);
+        s.simulation.integrator = cdpr_bench::core::scenario::IntegratorKind::Implicit;
+        s.simulation.t_final = 0.5;
+        s.simulation.sample_period = 0.5;
+        let go = || {
+            let mut sys = ClosedLoop::new(model(&s, n), &s).unwrap();
+            simulate(&mut sys, &RunOptions::from(&s), &mut |_| {}).unwrap()
+        };
+        let once = go();
+        println!(
+            "fe_spatial/implicit_0.5s_vs_n n{n}: {} steps, {} residuals, {} factorisations",
+            once.stats.steps_accepted, once.stats.rhs_evals, once.stats.factorisations
+        );
+        group.bench_function(format!("n{n}"), |b| b.iter(|| black_box(go().t_reached)));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, rhs, run, scaling);
 criterion_main!(benches);
