@@ -152,8 +152,13 @@ pub fn terms<const D: usize>(
 /// rate minus the relaxation by unstrained length flowing in.
 #[inline]
 pub fn strain_rate<const D: usize>(s: &ElementState<D>) -> f64 {
+    strain_rate_at(s, (s.rb - s.ra).norm())
+}
+
+/// [`strain_rate`] given the chord length |Δ| = `len` (the same value, one square root fewer).
+#[inline]
+fn strain_rate_at<const D: usize>(s: &ElementState<D>, len: f64) -> f64 {
     let delta = s.rb - s.ra;
-    let len = delta.norm();
     let strain = len * s.inv_h - 1.0;
     (delta.dot(&(s.vb - s.va)) / len - (1.0 + strain) * s.h_prime * s.l_rate) * s.inv_h
 }
@@ -170,11 +175,26 @@ pub fn damping_tension<const D: usize>(
     if damping == 0.0 {
         return (0.0, 0.0);
     }
-    let strain = (s.rb - s.ra).norm() * s.inv_h - 1.0;
+    damping_tension_at(mat, s, damping, (s.rb - s.ra).norm())
+}
+
+/// [`damping_tension`] given the chord length |Δ| = `len`, as the kernels have it (the same
+/// numbers, two square roots fewer per element).
+#[inline]
+fn damping_tension_at<const D: usize>(
+    mat: &Material,
+    s: &ElementState<D>,
+    damping: f64,
+    len: f64,
+) -> (f64, f64) {
+    if damping == 0.0 {
+        return (0.0, 0.0);
+    }
+    let strain = len * s.inv_h - 1.0;
     if strain <= 0.0 {
         return (0.0, 0.0);
     }
-    let rate = strain_rate(s);
+    let rate = strain_rate_at(s, len);
     let elastic = mat.ea * strain;
     ((elastic + damping * rate).max(0.0) - elastic, rate)
 }
@@ -257,7 +277,7 @@ pub fn terms_at_chord<const D: usize>(
     let len2 = delta.norm_squared();
     let len = chord.length;
     let (strain, n) = s.tension(mat.ea, len);
-    let (n_damp, _) = damping_tension(mat, s, damping);
+    let (n_damp, _) = damping_tension_at(mat, s, damping, chord.length);
     // (N + N_d) t with t = Δ/|Δ|: the pull on node a towards b.
     let pull = delta * ((n + n_damp) * chord.inv_length);
     let h_rate = s.h_prime * ld;
@@ -332,7 +352,7 @@ pub fn residual_at_chord<const D: usize>(
     let delta = s.rb - s.ra;
     let len2 = delta.norm_squared();
     let (strain, n) = s.tension(mat.ea, chord.length);
-    let (n_damp, _) = damping_tension(mat, s, damping);
+    let (n_damp, _) = damping_tension_at(mat, s, damping, chord.length);
     let h_rate = s.h_prime * ld;
     // (h a + h' l' a) and (h a_b + h' l' b): d(h r')/dt at each node.
     let da = aa * h + a * h_rate;

@@ -303,11 +303,18 @@ impl FeSpatial {
         sys.clear();
         let (n, nn) = (self.elements, self.elements - 1);
         let mat = self.material;
+        let np = self.positions_len();
         for (cable, &tension) in tensions.iter().enumerate().take(self.robot.cables()) {
             let o = cable * nn;
             let border = &mut sys.border[cable];
+            let li = self.l_index(cable);
+            let (h, l_rate) = (y[li] / n as f64, y[np + li]);
+            // Each node read once, carried from one element to the next (free_element's state).
+            let mut a = self.node(y, cable, 0);
             for e in 1..=n {
-                let s = self.free_element(y, cable, e);
+                let b = self.node(y, cable, e);
+                let s = ElementState::new(a, b, l_rate, h, 1.0 / n as f64);
+                a = b;
                 let k = &self.coefficients[e - 1];
                 let t = element::terms_at_chord(&mat, k, &s, self.axial_damping, Chord::of(&s));
                 if e > 1 {
