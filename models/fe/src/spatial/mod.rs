@@ -230,6 +230,25 @@ impl FeSpatial {
         )
     }
 
+    /// The free elements e = 1 … N of `cable`'s span in order, each node read once and carried
+    /// to the next element ([`Self::free_element`]'s states).
+    fn free_elements<'a>(
+        &'a self,
+        y: &'a [f64],
+        cable: usize,
+    ) -> impl Iterator<Item = ElementState<3>> + 'a {
+        let n = self.elements as f64;
+        let li = self.l_index(cable);
+        let (h, l_rate) = (y[li] / n, y[self.positions_len() + li]);
+        let mut a = self.node(y, cable, 0);
+        (1..=self.elements).map(move |e| {
+            let b = self.node(y, cable, e);
+            let s = ElementState::new(a, b, l_rate, h, 1.0 / n);
+            a = b;
+            s
+        })
+    }
+
     /// The stored element of `cable`: R = A + ρ r → A, unstrained L0 − l, h' = −1.
     fn stored_element(&self, y: &[f64], cable: usize) -> ElementState<3> {
         let (li, np) = (self.l_index(cable), self.positions_len());
@@ -303,18 +322,10 @@ impl FeSpatial {
         sys.clear();
         let (n, nn) = (self.elements, self.elements - 1);
         let mat = self.material;
-        let np = self.positions_len();
         for (cable, &tension) in tensions.iter().enumerate().take(self.robot.cables()) {
             let o = cable * nn;
             let border = &mut sys.border[cable];
-            let li = self.l_index(cable);
-            let (h, l_rate) = (y[li] / n as f64, y[np + li]);
-            // Each node read once, carried from one element to the next (free_element's state).
-            let mut a = self.node(y, cable, 0);
-            for e in 1..=n {
-                let b = self.node(y, cable, e);
-                let s = ElementState::new(a, b, l_rate, h, 1.0 / n as f64);
-                a = b;
+            for (e, s) in (1..=n).zip(self.free_elements(y, cable)) {
                 let k = &self.coefficients[e - 1];
                 let t = element::terms_at_chord(&mat, k, &s, self.axial_damping, Chord::of(&s));
                 if e > 1 {
@@ -500,9 +511,8 @@ impl CableModel<3> for FeSpatial {
         let mat = &self.material;
         let mut e = Energy::default();
         for cable in 0..self.robot.cables() {
-            for el in 1..=self.elements {
-                let s = self.free_element(y, cable, el);
-                let (k, u, g) = element::energies(mat, &self.coefficients[el - 1], &s);
+            for (s, k) in self.free_elements(y, cable).zip(&self.coefficients) {
+                let (k, u, g) = element::energies(mat, k, &s);
                 e.kinetic += k;
                 e.elastic += u;
                 e.gravity += g;
@@ -529,8 +539,7 @@ impl CableModel<3> for FeSpatial {
         }
         let mut d = 0.0;
         for cable in 0..self.robot.cables() {
-            for el in 1..=self.elements {
-                let s = self.free_element(y, cable, el);
+            for s in self.free_elements(y, cable) {
                 d += element::dissipation(&self.material, &s, self.axial_damping);
             }
             if !self.length_driven {
