@@ -10,9 +10,11 @@
 
 use crate::spatial_modes::{SpatialLoop, SpatialModes, at_pose};
 use crate::{Result, pool};
+use cdpr_bench::ModelKind;
 use cdpr_bench::core::runner::Observer;
 use cdpr_bench::core::scenario::{
-    AutoWord, ControllerKind, Designed, FirmwareShaper, FlexCompensation, Printer, Scenario,
+    AutoWord, ControllerKind, Designed, FirmwareShaper, FlexCompensation, IntegratorKind, Printer,
+    Scenario,
 };
 use cdpr_bench::printing::gcode::MoveKind;
 use std::fmt::Write as _;
@@ -75,9 +77,15 @@ pub struct Part {
     pub layers: RangeInclusive<usize>,
 }
 
+/// The massive lines the cube is printed on too (implicit path, h = 1e-4 s), at the sizes of
+/// the print goals: lumped lines of 20 springs, FE cables of 10 elements.
+pub const MASSIVE: [(ModelKind, usize); 2] = [(ModelKind::Lumped, 20), (ModelKind::Fe, 10)];
+
 /// One print of the study.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Row {
+    /// The cable model ("elastic", "lumped", "fe").
+    pub model: &'static str,
     pub part: String,
     pub setup: &'static str,
     pub accel_mm_s2: f64,
@@ -96,6 +104,9 @@ pub struct Row {
     pub tracking_err_max: f64,
     pub steps: u64,
     pub rhs_evaluations: u64,
+    /// Why the print stopped before its end (its errors then NaN), if it did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<String>,
 }
 
 /// The study's prints and the frequencies it shaped at.
@@ -186,16 +197,20 @@ pub fn layer_centre(scenario: &Scenario, part: &Part) -> Result<[f64; 3]> {
     Ok([0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k])))
 }
 
-/// One job: a part, a setup, an acceleration, a shaper.
+/// One job: a part, a setup, an acceleration, a shaper, a cable model.
 struct Job<'a> {
     part: &'a Part,
     setup: Setup,
     accel: f64,
     shaper: FirmwareShaper,
+    model: ModelKind,
 }
 
-/// Runs the study on `base` (a printing robot's scenario) for `parts`.
-pub fn run(base: &Scenario, parts: &[Part]) -> Result<PrintStudy> {
+/// Runs the study on `base` (a printing robot's scenario) for `parts`, and the first part on
+/// the [`MASSIVE`] lines at the accelerations `massive` [mm/s²] (seconds a print each, where an
+/// elastic one takes tens of milliseconds: the report takes the issue's 3 000 mm/s², `cargo
+/// xtask print-study` all of [`ACCELERATIONS`]).
+pub fn run(base: &Scenario, parts: &[Part], massive: &[f64]) -> Result<PrintStudy> {
     let mut jobs = Vec::new();
     for part in parts {
         for setup in SETUPS {
@@ -206,6 +221,7 @@ pub fn run(base: &Scenario, parts: &[Part]) -> Result<PrintStudy> {
                         setup,
                         accel,
                         shaper,
+                        model: ModelKind::Elastic,
                     });
                 }
             }
@@ -225,49 +241,135 @@ pub fn run(base: &Scenario, parts: &[Part]) -> Result<PrintStudy> {
             ));
         }
     }
-    let rows = pool::map(&jobs, |job| -> Result<Row> {
-        let mut s = configure(base, job.setup, job.accel, job.shaper);
-        let freqs = resolved
+    let freqs = |job: &Job| {
+        resolved
             .iter()
             .find(|(key, _)| key.0 == job.part.name && key.1 == job.setup.label)
             .map(|(_, f)| *f)
-            .expect("resolved per part and setup");
-        let printer = s.printer.as_mut().expect("configured");
-        (printer.shaper_freq_x, printer.shaper_freq_y) = (freqs[0], freqs[1]);
-        let print = cdpr_bench::prepare_print(&s, &job.part.gcode, Some(job.part.layers.clone()))?;
-        let run = cdpr_bench::simulate_print(&s, &print, &mut Observer::progress(&mut |_| {}))?;
-        let c = &run.contour;
-        let hz = |f: Designed| match f {
-            Designed::Value(v) => v,
-            Designed::Auto(_) => f64::NAN,
-        };
-        Ok(Row {
-            part: job.part.name.clone(),
-            setup: job.setup.label,
-            accel_mm_s2: job.accel,
-            shaper: job.shaper.name().to_string(),
-            shaper_freq_hz: if job.shaper == FirmwareShaper::None {
-                [f64::NAN; 2]
-            } else {
-                [hz(freqs[0]), hz(freqs[1])]
-            },
-            print_time_s: print.path.plan().print_time,
-            contour_err_max_printing: c.printing.max,
-            contour_err_rms_printing: c.printing.rms,
-            contour_err_max: c.overall.max,
-            contour_err_p99: c.overall.p99,
-            contour_err_max_external_perimeter: c
-                .by_kind
-                .get(&MoveKind::ExternalPerimeter)
-                .map_or(f64::NAN, |s| s.max),
-            tracking_err_max: c.tracking.max,
-            steps: run.run.stats.steps_accepted,
-            rhs_evaluations: run.run.stats.rhs_evals,
-        })
-    })?;
-    Ok(PrintStudy {
+            .expect("resolved per part and setup")
+    };
+    let rows = pool::map(&jobs, |job| print_row(base, job, freqs(job)))?;
+    let mut study = PrintStudy {
         rows: rows.into_iter().collect::<Result<_>>()?,
+    };
+    // The cube on the massive lines, unshaped and with the elastic study's best shaper (the
+    // one a builder calibrates on the loop's modes), at the same frequencies.
+    let accelerations = massive;
+    let mut massive = Vec::new();
+    for (model, elements) in MASSIVE {
+        let s = massive_variant(base, model, elements)?;
+        for setup in SETUPS {
+            for &accel in accelerations {
+                let best = study
+                    .pair(
+                        ModelKind::Elastic.name(),
+                        &parts[0].name,
+                        setup.label,
+                        accel,
+                    )
+                    .map(|(_, b)| b.shaper.clone());
+                let shapers = SHAPERS
+                    .iter()
+                    .filter(|f| Some(f.name().to_string()) == best);
+                for &shaper in std::iter::once(&FirmwareShaper::None).chain(shapers) {
+                    massive.push((
+                        s.clone(),
+                        Job {
+                            part: &parts[0],
+                            setup,
+                            accel,
+                            shaper,
+                            model,
+                        },
+                    ));
+                }
+            }
+        }
+    }
+    let rows = pool::map(&massive, |(s, job)| {
+        print_row(s, job, freqs(job)).unwrap_or_else(|e| stopped_row(job, e.to_string()))
+    })?;
+    study.rows.extend(rows);
+    Ok(study)
+}
+
+/// The modelled line of the massive prints [m]: examples/robots/hangprinter-lumped.toml's (the
+/// Hangprinter's longest chord 2.30 m, its stretch, and spare stored line on the reel).
+const MASSIVE_LINE_LENGTH: f64 = 3.2;
+
+/// `base` on massive lines of `model` with `elements` each, on the implicit path.
+fn massive_variant(base: &Scenario, model: ModelKind, elements: usize) -> Result<Scenario> {
+    let mut config = cdpr_bench::ModelConfig::from_scenario(base)?;
+    config.kind = model;
+    config.elements = Some(elements as i64);
+    let mut s = base.clone();
+    s.cable.modelled_length = MASSIVE_LINE_LENGTH;
+    s.model = config.section();
+    s.simulation.integrator = IntegratorKind::Implicit;
+    cdpr_bench::validate(&s)?;
+    Ok(s)
+}
+
+/// One print of `job` on `base` (configured for it), shaped at `freqs` (x, y).
+fn print_row(base: &Scenario, job: &Job, freqs: [Designed; 2]) -> Result<Row> {
+    let mut s = configure(base, job.setup, job.accel, job.shaper);
+    let printer = s.printer.as_mut().expect("configured");
+    (printer.shaper_freq_x, printer.shaper_freq_y) = (freqs[0], freqs[1]);
+    let print = cdpr_bench::prepare_print(&s, &job.part.gcode, Some(job.part.layers.clone()))?;
+    let run = cdpr_bench::simulate_print(&s, &print, &mut Observer::progress(&mut |_| {}))?;
+    let c = &run.contour;
+    let hz = |f: Designed| match f {
+        Designed::Value(v) => v,
+        Designed::Auto(_) => f64::NAN,
+    };
+    Ok(Row {
+        model: job.model.name(),
+        part: job.part.name.clone(),
+        setup: job.setup.label,
+        accel_mm_s2: job.accel,
+        shaper: job.shaper.name().to_string(),
+        shaper_freq_hz: if job.shaper == FirmwareShaper::None {
+            [f64::NAN; 2]
+        } else {
+            [hz(freqs[0]), hz(freqs[1])]
+        },
+        print_time_s: print.path.plan().print_time,
+        contour_err_max_printing: c.printing.max,
+        contour_err_rms_printing: c.printing.rms,
+        contour_err_max: c.overall.max,
+        contour_err_p99: c.overall.p99,
+        contour_err_max_external_perimeter: c
+            .by_kind
+            .get(&MoveKind::ExternalPerimeter)
+            .map_or(f64::NAN, |s| s.max),
+        tracking_err_max: c.tracking.max,
+        steps: run.run.stats.steps_accepted,
+        rhs_evaluations: run.run.stats.rhs_evals,
+        stopped: None,
     })
+}
+
+/// The row of a print that stopped (a line gone slack, the integrator's failure): its errors
+/// NaN and why.
+fn stopped_row(job: &Job, why: String) -> Row {
+    Row {
+        model: job.model.name(),
+        part: job.part.name.clone(),
+        setup: job.setup.label,
+        accel_mm_s2: job.accel,
+        shaper: job.shaper.name().to_string(),
+        shaper_freq_hz: [f64::NAN; 2],
+        print_time_s: f64::NAN,
+        contour_err_max_printing: f64::NAN,
+        contour_err_rms_printing: f64::NAN,
+        contour_err_max: f64::NAN,
+        contour_err_p99: f64::NAN,
+        contour_err_max_external_perimeter: f64::NAN,
+        tracking_err_max: f64::NAN,
+        steps: 0,
+        rhs_evaluations: 0,
+        stopped: Some(why),
+    }
 }
 
 /// `base` with the setup's controller, the printing acceleration and the shaper (frequencies
@@ -303,13 +405,13 @@ impl PrintStudy {
         )
     }
 
-    /// The unshaped print and the best shaped one (lowest contour error) of a part, setup and
-    /// acceleration.
-    pub fn pair(&self, part: &str, setup: &str, accel: f64) -> Option<(&Row, &Row)> {
+    /// The unshaped print and the best shaped one (lowest contour error) of a cable model, part,
+    /// setup and acceleration.
+    pub fn pair(&self, model: &str, part: &str, setup: &str, accel: f64) -> Option<(&Row, &Row)> {
         let mine = || {
-            self.rows
-                .iter()
-                .filter(move |r| r.part == part && r.setup == setup && r.accel_mm_s2 == accel)
+            self.rows.iter().filter(move |r| {
+                r.model == model && r.part == part && r.setup == setup && r.accel_mm_s2 == accel
+            })
         };
         let unshaped = mine().find(|r| r.shaper == "none")?;
         let best = mine().filter(|r| r.shaper != "none").min_by(|a, b| {
@@ -321,10 +423,10 @@ impl PrintStudy {
 
     /// The highest acceleration whose contour error stays within [`GOOD_CONTOUR`] (None: not
     /// even the lowest), unshaped and best-shaped.
-    pub fn knee(&self, part: &str, setup: &str) -> [Option<f64>; 2] {
+    pub fn knee(&self, model: &str, part: &str, setup: &str) -> [Option<f64>; 2] {
         let mut knee = [None, None];
         for accel in ACCELERATIONS {
-            if let Some((u, b)) = self.pair(part, setup, accel) {
+            if let Some((u, b)) = self.pair(model, part, setup, accel) {
                 for (slot, row) in knee.iter_mut().zip([u, b]) {
                     if row.contour_err_max_printing <= GOOD_CONTOUR {
                         *slot = Some(accel);
@@ -336,10 +438,16 @@ impl PrintStudy {
     }
 
     /// The study's tables: per part, each setup and acceleration unshaped and best-shaped,
-    /// then each setup's knee.
+    /// then each setup's knee; then the cube on every cable model.
     pub fn markdown(&self) -> String {
         let mut md = String::new();
-        let mut parts: Vec<&str> = self.rows.iter().map(|r| r.part.as_str()).collect();
+        let elastic = ModelKind::Elastic.name();
+        let mut parts: Vec<&str> = self
+            .rows
+            .iter()
+            .filter(|r| r.model == elastic)
+            .map(|r| r.part.as_str())
+            .collect();
         parts.dedup();
         let um = |v: f64| format!("{:.1}", v * 1e6);
         for part in parts {
@@ -352,7 +460,7 @@ impl PrintStudy {
             );
             for setup in SETUPS {
                 for accel in ACCELERATIONS {
-                    let Some((u, b)) = self.pair(part, setup.label, accel) else {
+                    let Some((u, b)) = self.pair(elastic, part, setup.label, accel) else {
                         continue;
                     };
                     let _ = writeln!(
@@ -380,7 +488,7 @@ impl PrintStudy {
                 SETUPS
                     .iter()
                     .map(|s| {
-                        let [u, b] = self.knee(part, s.label);
+                        let [u, b] = self.knee(elastic, part, s.label);
                         let f =
                             |k: Option<f64>| k.map_or("none".to_string(), |a| format!("{a:.0}"));
                         format!("{} {} / {}", s.label, f(u), f(b))
@@ -388,6 +496,99 @@ impl PrintStudy {
                     .collect::<Vec<_>>()
                     .join("; ")
             );
+        }
+        md + &self.massive_markdown()
+    }
+
+    /// The cube on every cable model: per setup and acceleration the printing moves' largest
+    /// contour error, unshaped / with the elastic study's best shaper, and each model's knees.
+    fn massive_markdown(&self) -> String {
+        let Some(part) = self
+            .rows
+            .iter()
+            .find(|r| r.model != ModelKind::Elastic.name())
+        else {
+            return String::new();
+        };
+        let part = part.part.as_str();
+        let models: Vec<&str> = std::iter::once(ModelKind::Elastic)
+            .chain(MASSIVE.map(|(m, _)| m))
+            .map(|m| m.name())
+            .collect();
+        let cell = |model: &str, setup: &str, accel: f64| match self.pair(model, part, setup, accel)
+        {
+            Some((u, b)) => format!(
+                "{:.1} / {:.1}",
+                u.contour_err_max_printing * 1e6,
+                b.contour_err_max_printing * 1e6
+            ),
+            None => {
+                let stopped = self.rows.iter().any(|r| {
+                    r.model == model
+                        && r.setup == setup
+                        && r.accel_mm_s2 == accel
+                        && r.stopped.is_some()
+                });
+                if stopped {
+                    "stopped".into()
+                } else {
+                    "—".into()
+                }
+            }
+        };
+        let mut md = format!(
+            "**{part} on every cable model** (lumped lines of {} springs and FE cables of {} \
+             elements on the implicit path, h = 1e-4 s) — the printing moves' largest contour \
+             error [µm], unshaped / with the elastic study's best shaper at its frequencies\n\n\
+             | controller | accel [mm/s²] | {} |\n|---|---:|{}\n",
+            MASSIVE[0].1,
+            MASSIVE[1].1,
+            models.join(" | "),
+            "---:|".repeat(models.len())
+        );
+        let mut accelerations: Vec<f64> = self
+            .rows
+            .iter()
+            .filter(|r| r.model != ModelKind::Elastic.name())
+            .map(|r| r.accel_mm_s2)
+            .collect();
+        accelerations.sort_by(f64::total_cmp);
+        accelerations.dedup();
+        for setup in SETUPS {
+            for &accel in &accelerations {
+                let cells: Vec<String> =
+                    models.iter().map(|m| cell(m, setup.label, accel)).collect();
+                let _ = writeln!(
+                    md,
+                    "| {} | {accel:.0} | {} |",
+                    setup.label,
+                    cells.join(" | ")
+                );
+            }
+        }
+        let knees: Vec<String> = models
+            .iter()
+            .map(|m| {
+                let per: Vec<String> = SETUPS
+                    .iter()
+                    .map(|s| {
+                        let [u, b] = self.knee(m, part, s.label);
+                        let f =
+                            |k: Option<f64>| k.map_or("none".to_string(), |a| format!("{a:.0}"));
+                        format!("{} {} / {}", s.label, f(u), f(b))
+                    })
+                    .collect();
+                format!("{m}: {}", per.join("; "))
+            })
+            .collect();
+        if accelerations.len() == ACCELERATIONS.len() {
+            let _ = writeln!(
+                md,
+                "\nKnees, unshaped / best-shaped — {}\n",
+                knees.join(". ")
+            );
+        } else {
+            md.push('\n');
         }
         md
     }

@@ -1,12 +1,14 @@
 //! `cargo xtask print-study`: the printer's speed–accuracy frontier
 //! ([`cdpr_studies::print_study`]) → DIR/print-study.json, DIR/print-study.md and
 //! DIR/print-frontier.svg|png (contour error against print time, every setup unshaped and
-//! best-shaped, one panel per part).
+//! best-shaped, one panel per part, elastic cables); the cube on the massive lines at every
+//! acceleration (80 prints of seconds each: minutes, where the report takes 3 000 mm/s² only).
 
 use crate::figures::{Figure, LINE_WIDTH, Line, Marker, Panel, render};
 use crate::output::{write_atomic, write_json};
 use crate::simulate::writable_out;
 use anyhow::{Context, Result};
+use cdpr_bench::ModelKind;
 use cdpr_bench::core::scenario::Scenario;
 use cdpr_studies::print_study::{self, ACCELERATIONS, GOOD_CONTOUR, Part, PrintStudy, SETUPS};
 use plotters::prelude::RGBColor;
@@ -42,7 +44,7 @@ pub fn parts() -> Result<Vec<Part>> {
 /// Runs the study into `out`.
 pub fn run(out: &Path) -> Result<()> {
     writable_out(out)?;
-    let study = print_study::run(&printer_scenario()?, &parts()?)?;
+    let study = print_study::run(&printer_scenario()?, &parts()?, &ACCELERATIONS)?;
     write(&study, out)?;
     print!("{}", study.markdown());
     Ok(())
@@ -66,7 +68,12 @@ const SETUP_COLORS: [RGBColor; 5] = [
 
 /// Contour error [µm] against print time [s], per part.
 fn frontier(study: &PrintStudy) -> Figure {
-    let mut parts: Vec<&str> = study.rows.iter().map(|r| r.part.as_str()).collect();
+    let mut parts: Vec<&str> = study
+        .rows
+        .iter()
+        .filter(|r| r.model == ModelKind::Elastic.name())
+        .map(|r| r.part.as_str())
+        .collect();
     parts.dedup();
     let panels = parts
         .into_iter()
@@ -76,7 +83,9 @@ fn frontier(study: &PrintStudy) -> Figure {
                 for (shaped, dashed) in [(false, true), (true, false)] {
                     let points = ACCELERATIONS
                         .iter()
-                        .filter_map(|&a| study.pair(part, setup.label, a))
+                        .filter_map(|&a| {
+                            study.pair(ModelKind::Elastic.name(), part, setup.label, a)
+                        })
                         .map(|(u, b)| {
                             let r = if shaped { b } else { u };
                             (r.print_time_s, r.contour_err_max_printing * 1e6)

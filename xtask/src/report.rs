@@ -170,12 +170,14 @@ fn beyond_the_paper(base: &Scenario, out: &Path) -> Result<String> {
 /// Targets per axis of the spatial section's build-volume grids.
 const SPATIAL_POINTS: usize = 5;
 
-/// The printer's speed–accuracy frontier (160 prints of two first layers, ~30 s on two cores):
+/// The printer's speed–accuracy frontier (160 prints of two first layers on elastic cables, ~30
+/// s on two cores; the cube at 3 000 mm/s² on the massive lines, 20 prints of seconds each):
 /// its files into `out`, its section of REPORT.md returned.
 fn printing_section(out: &Path) -> Result<String> {
     let printing = cdpr_studies::print_study::run(
         &crate::print_study::printer_scenario()?,
         &crate::print_study::parts()?,
+        &[3000.0],
     )?;
     crate::print_study::write(&printing, out)?;
     Ok(printing.section("print-frontier"))

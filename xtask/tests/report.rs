@@ -159,6 +159,47 @@ fn report_writes_every_figure_table_and_file() {
         let b = std::fs::read(again_dir.join("out").join(name)).unwrap();
         assert!(a == b, "{name} differs between runs");
     }
+    // The print study: the cube on the massive lines at 3 000 mm/s², every setup printed to its
+    // end; the tension controllers there within 3 µm of the elastic prints (the lines' 3 g
+    // against the 1 kg effector change the 35 µm error by ~1 µm: 0.2–1.1 µm measured).
+    let study: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("print-study.json")).unwrap())
+            .unwrap();
+    let rows = study["rows"].as_array().unwrap();
+    let unshaped = |model: &str, setup: &str| {
+        rows.iter()
+            .find(|r| {
+                r["model"] == model
+                    && r["part"] == rows[0]["part"]
+                    && r["setup"] == setup
+                    && r["accel_mm_s2"] == 3000.0
+                    && r["shaper"] == "none"
+            })
+            .unwrap_or_else(|| panic!("no {model} {setup} print"))
+    };
+    for model in ["lumped", "fe"] {
+        let massive: Vec<_> = rows.iter().filter(|r| r["model"] == model).collect();
+        assert_eq!(
+            massive.len(),
+            10,
+            "{model}: five setups, unshaped and shaped"
+        );
+        assert!(
+            massive.iter().all(|r| r.get("stopped").is_none()),
+            "{model}: a print stopped"
+        );
+        for setup in ["computed-torque", "lqr"] {
+            let [a, b] = [model, "elastic"].map(|m| {
+                unshaped(m, setup)["contour_err_max_printing"]
+                    .as_f64()
+                    .unwrap()
+            });
+            assert!(
+                (a - b).abs() <= 3e-6,
+                "{model} {setup}: {a} m against elastic {b} m"
+            );
+        }
+    }
     let leftovers: Vec<_> = std::fs::read_dir(&out)
         .unwrap()
         .filter_map(|e| e.ok())
