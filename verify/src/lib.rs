@@ -7,3 +7,4 @@
 
 pub mod acceptance;
 pub mod irvine;
+pub mod spatial;

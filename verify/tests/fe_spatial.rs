@@ -108,14 +108,7 @@ proptest! {
 /// The Hangprinter example on FE cables of `elements` elements, line density `density`
 /// [kg/m³] (the example's 970).
 fn hangprinter(elements: usize, density: f64) -> Scenario {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../examples/robots/hangprinter-lumped.toml");
-    let text = std::fs::read_to_string(path)
-        .unwrap()
-        .replace("kind = \"lumped\"", "kind = \"fe\"")
-        .replace("elements = 20", &format!("elements = {elements}"))
-        .replace("density = 970.0", &format!("density = {density}"));
-    Scenario::from_toml_str(&text).unwrap()
+    cdpr_verify::spatial::hangprinter("fe", elements, density)
 }
 
 /// The rest at `p` under the QP's tensions there, N elements, line density `density`.

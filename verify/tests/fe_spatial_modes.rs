@@ -17,14 +17,7 @@ use cdpr_bench::fe::spatial::FeSpatial;
 /// The Hangprinter example on FE cables of `elements` elements, line density `density`
 /// [kg/m³] (the example's 970).
 fn hangprinter(elements: usize, density: f64) -> Scenario {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../examples/robots/hangprinter-lumped.toml");
-    let text = std::fs::read_to_string(path)
-        .unwrap()
-        .replace("kind = \"lumped\"", "kind = \"fe\"")
-        .replace("elements = 20", &format!("elements = {elements}"))
-        .replace("density = 970.0", &format!("density = {density}"));
-    Scenario::from_toml_str(&text).unwrap()
+    cdpr_verify::spatial::hangprinter("fe", elements, density)
 }
 
 /// `scenario`'s FE robot at rest at `p` under `tensions`, its reels then locked.
@@ -116,7 +109,7 @@ fn a_taut_lines_transverse_modes_are_the_consistent_strings() {
 }
 
 /// The effector's x, y and vertical modes, ascending [rad/s], each ≥ 90 % effector motion.
-fn effector_modes(named: &RestModes) -> Vec<f64> {
+fn pure_effector_modes(named: &RestModes) -> Vec<f64> {
     let mut effector: Vec<f64> = [ModeKind::EffectorX, ModeKind::EffectorY, ModeKind::Vertical]
         .into_iter()
         .map(|kind| {
@@ -172,7 +165,7 @@ fn the_effector_modes_tend_to_the_elastic_lines_as_the_mass_vanishes() {
         let named = rest_modes(&mut model, &rest, &[0.0; 4]).unwrap();
         let asymmetry = named.asymmetry.unwrap();
         assert!(asymmetry <= 1e-8, "asymmetry {asymmetry:e}");
-        let fe = effector_modes(&named);
+        let fe = pure_effector_modes(&named);
         let elastic = elastic_locked_modes(&model, &rest);
         eprintln!("density {density}: FE {fe:?}, elastic {elastic:?} rad/s");
         fe.iter()
@@ -268,11 +261,11 @@ fn the_effectors_modes_at_any_n_by_shift_invert() {
     let (mut model, rest) = locked(&scenario, &p, holding(&scenario, &p));
     let dense = rest_modes(&mut model, &rest, &[0.0; 4]).unwrap();
     let (near, _) = rest_modes_near(&mut model, &rest, &[0.0; 4], (120.0, 6, 60)).unwrap();
-    let mut expected: Vec<f64> = dense.modes.iter().map(|m| m.mode.omega).collect();
-    expected.sort_by(|a, b| (a * a - 14400.0).abs().total_cmp(&(b * b - 14400.0).abs()));
-    expected.truncate(6);
-    expected.sort_by(f64::total_cmp);
-    for (found, expected) in near.modes.iter().zip(&expected) {
+    for (found, expected) in near
+        .modes
+        .iter()
+        .zip(&cdpr_verify::spatial::nearest(&dense, 120.0, 6))
+    {
         let omega = found.mode.omega;
         assert!(
             (omega - expected).abs() <= 1e-8 * expected,
@@ -284,18 +277,7 @@ fn the_effectors_modes_at_any_n_by_shift_invert() {
     let (near, residuals) =
         rest_modes_near(&mut fine, &fine_rest, &[0.0; 4], (120.0, 12, 80)).unwrap();
     let elastic = elastic_locked_modes(&fine, &fine_rest);
-    let mut effector: Vec<f64> = [ModeKind::EffectorX, ModeKind::EffectorY, ModeKind::Vertical]
-        .into_iter()
-        .map(|kind| {
-            near.modes
-                .iter()
-                .find(|m| m.kind == kind)
-                .unwrap_or_else(|| panic!("no {kind} mode near 120 rad/s"))
-                .mode
-                .omega
-        })
-        .collect();
-    effector.sort_by(f64::total_cmp);
+    let effector = cdpr_verify::spatial::effector_modes(&near);
     eprintln!(
         "N = 1000: effector {effector:?}, elastic {elastic:?} rad/s, residuals {residuals:?}"
     );

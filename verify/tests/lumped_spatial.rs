@@ -1094,16 +1094,12 @@ fn the_locked_robots_modes_are_named_and_match_their_closed_forms() {
 /// and within 0.5 % of the elastic lines' with the same locked lengths, as at N = 20.
 #[test]
 fn the_effectors_modes_at_any_n_by_shift_invert() {
-    use cdpr_bench::analysis::modes::ModeKind;
     use cdpr_bench::analysis::rest_modes::{rest_modes, rest_modes_near};
+    use cdpr_verify::spatial::{effector_modes, nearest};
     let (mut model, rest) = locked_at_origin(20);
     let dense = rest_modes(&mut model, &rest, &[0.0; 4]).unwrap();
     let (near, _) = rest_modes_near(&mut model, &rest, &[0.0; 4], (120.0, 6, 60)).unwrap();
-    let mut expected: Vec<f64> = dense.modes.iter().map(|m| m.mode.omega).collect();
-    expected.sort_by(|a, b| (a * a - 14400.0).abs().total_cmp(&(b * b - 14400.0).abs()));
-    expected.truncate(6);
-    expected.sort_by(f64::total_cmp);
-    for (found, expected) in near.modes.iter().zip(&expected) {
+    for (found, expected) in near.modes.iter().zip(&nearest(&dense, 120.0, 6)) {
         let omega = found.mode.omega;
         assert!(
             (omega - expected).abs() <= 1e-9 * expected,
@@ -1114,18 +1110,7 @@ fn the_effectors_modes_at_any_n_by_shift_invert() {
     let (near, residuals) =
         rest_modes_near(&mut fine, &fine_rest, &[0.0; 4], (120.0, 6, 60)).unwrap();
     let elastic = elastic_locked_modes(&fine, &fine_rest);
-    let mut effector: Vec<f64> = [ModeKind::EffectorX, ModeKind::EffectorY, ModeKind::Vertical]
-        .into_iter()
-        .map(|kind| {
-            near.modes
-                .iter()
-                .find(|m| m.kind == kind)
-                .unwrap_or_else(|| panic!("no {kind} mode near 120 rad/s"))
-                .mode
-                .omega
-        })
-        .collect();
-    effector.sort_by(f64::total_cmp);
+    let effector = effector_modes(&near);
     eprintln!(
         "N = 1000: effector {effector:?}, elastic {elastic:?} rad/s, residuals {residuals:?}"
     );
