@@ -147,6 +147,18 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 mod tests {
     use super::*;
 
+    /// The four of the string's eigenvalues λ(cos θ_j), θ_j = jπ/(n + 1), nearest `shift`,
+    /// ascending.
+    fn nearest_of(n: usize, shift: f64, value: impl Fn(f64) -> f64) -> Vec<f64> {
+        let mut exact: Vec<f64> = (1..=n)
+            .map(|j| value((j as f64 * std::f64::consts::PI / (n as f64 + 1.0)).cos()))
+            .collect();
+        exact.sort_by(|a, b| (a - shift).abs().total_cmp(&(b - shift).abs()));
+        exact.truncate(4);
+        exact.sort_by(f64::total_cmp);
+        exact
+    }
+
     /// The path graph's Laplacian (the fixed–fixed string) has λ_j = 2 − 2 cos(jπ/(n+1)):
     /// the four nearest 1.0 of n = 400, by solves with the dense inverse of A − σ I.
     #[test]
@@ -171,12 +183,7 @@ mod tests {
             }
         };
         let pairs = nearest(n, shift, 4, 80, solve).unwrap();
-        let mut exact: Vec<f64> = (1..=n)
-            .map(|j| 2.0 - 2.0 * (j as f64 * std::f64::consts::PI / (n as f64 + 1.0)).cos())
-            .collect();
-        exact.sort_by(|a, b| (a - shift).abs().total_cmp(&(b - shift).abs()));
-        let mut nearest4 = exact[..4].to_vec();
-        nearest4.sort_by(f64::total_cmp);
+        let nearest4 = nearest_of(n, shift, |c| 2.0 - 2.0 * c);
         for (p, e) in pairs.iter().zip(&nearest4) {
             assert!((p.value - e).abs() <= 1e-10, "{} against {e}", p.value);
         }
@@ -217,15 +224,7 @@ mod tests {
             }
         };
         let pairs = nearest_with_mass(n, shift, 4, 80, solve, product).unwrap();
-        let mut exact: Vec<f64> = (1..=n)
-            .map(|j| {
-                let c = (j as f64 * std::f64::consts::PI / (n as f64 + 1.0)).cos();
-                6.0 * (1.0 - c) / (2.0 + c)
-            })
-            .collect();
-        exact.sort_by(|a, b| (a - shift).abs().total_cmp(&(b - shift).abs()));
-        let mut nearest4 = exact[..4].to_vec();
-        nearest4.sort_by(f64::total_cmp);
+        let nearest4 = nearest_of(n, shift, |c| 6.0 * (1.0 - c) / (2.0 + c));
         for (p, e) in pairs.iter().zip(&nearest4) {
             assert!((p.value - e).abs() <= 1e-10, "{} against {e}", p.value);
             let mut mx = vec![0.0; n];

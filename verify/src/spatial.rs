@@ -48,3 +48,15 @@ pub fn effector_modes(modes: &RestModes) -> Vec<f64> {
     effector.sort_by(f64::total_cmp);
     effector
 }
+
+/// The three frequencies [rad/s], ascending, of a point mass `mass` [kg] held by the stiffness
+/// `stiffness` [N/m]: the effector of a locked robot on massless lines.
+pub fn point_mass_modes(stiffness: &cdpr_bench::core::robot::Matrix<3>, mass: f64) -> Vec<f64> {
+    let mut omega: Vec<f64> = stiffness
+        .symmetric_eigenvalues()
+        .iter()
+        .map(|k| (k / mass).sqrt())
+        .collect();
+    omega.sort_by(f64::total_cmp);
+    omega
+}

@@ -141,13 +141,7 @@ fn elastic_locked_modes(model: &FeSpatial, rest: &[f64]) -> Vec<f64> {
         stiffness += u * u.transpose() * (model.material.ea / l)
             + (nalgebra::Matrix3::identity() - u * u.transpose()) * (t / d);
     }
-    let mut elastic: Vec<f64> = stiffness
-        .symmetric_eigenvalues()
-        .iter()
-        .map(|k| (k / model.robot().effector_mass).sqrt())
-        .collect();
-    elastic.sort_by(f64::total_cmp);
-    elastic
+    cdpr_verify::spatial::point_mass_modes(&stiffness, model.robot().effector_mass)
 }
 
 /// The Hangprinter at rest at (0.1, 0.05, 0) m on FE lines (N = 10), reels locked: its

@@ -962,13 +962,7 @@ fn elastic_locked_modes(model: &LumpedSpatial, rest: &[f64]) -> Vec<f64> {
         stiffness += u * u.transpose() * (ea / locked)
             + (nalgebra::Matrix3::identity() - u * u.transpose()) * (t / l);
     }
-    let mut elastic: Vec<f64> = stiffness
-        .symmetric_eigenvalues()
-        .iter()
-        .map(|k| (k / model.robot().effector_mass).sqrt())
-        .collect();
-    elastic.sort_by(f64::total_cmp);
-    elastic
+    cdpr_verify::spatial::point_mass_modes(&stiffness, model.robot().effector_mass)
 }
 
 /// The Hangprinter example on lumped lines at rest at its start pose, reels locked (the
