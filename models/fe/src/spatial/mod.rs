@@ -6,11 +6,12 @@
 //!
 //! Generalised coordinates: per cable i its free nodes k = 1 … N − 1 (x, y, z each, cable-major),
 //! then P, then per cable (l_i, ρ_i); n = 3m(N − 1) + 3 + 2m, the state (q, q'). M q'' = F is
-//! solved on the star of arms in O(N m) ([`star`]); the implicit path's form is [`implicit`].
-//! The stored cable is elastic (FE.1.3's reference variant); the rigid variant is planar only.
+//! solved on the star of arms in O(N m) ([`star`]); the implicit path's form is [`implicit`];
+//! reels driven by length prescribe l_i ([`prescribed`]). The stored cable is elastic (FE.1.3's reference variant); the rigid variant is planar only.
 
 mod blocks;
 mod implicit;
+mod prescribed;
 mod star;
 mod statics;
 
@@ -146,14 +147,6 @@ impl FeSpatial {
         }
     }
 
-    /// Locks every reel (or hands it to the commanded tensions): the length reels holding still
-    /// (MODELS.md §11, the firmware's printer between moves) — Du's form with no command, each
-    /// l_i held by the reel loop, the stored cable on the reel.
-    pub fn lock_reels(&mut self, locked: bool) {
-        self.length_driven = locked;
-        self.drive = None;
-    }
-
     /// Number of generalised coordinates n = 3m(N − 1) + 3 + 2m.
     pub fn positions_len(&self) -> usize {
         3 * self.robot.cables() * (self.elements - 1) + 3 + 2 * self.robot.cables()
@@ -271,48 +264,6 @@ impl FeSpatial {
             self.prescribe_lengths(&mut sys, y);
         }
         self.system = sys;
-    }
-
-    /// The commanded l_i'' [m/s²]: l̈0_i plus the velocity loop (l̇0_i − l_i')/τ
-    /// ([`cdpr_core::robot::reels::REEL_TIME_CONSTANT`]), as the lumped lines' reels.
-    fn commanded_l_acceleration(&self, y: &[f64], cable: usize) -> f64 {
-        let l_rate = y[self.positions_len() + self.l_index(cable)];
-        let (rate, acceleration) = self.drive.map_or((0.0, 0.0), |(r, a)| (r[cable], a[cable]));
-        acceleration + (rate - l_rate) / cdpr_core::robot::reels::REEL_TIME_CONSTANT
-    }
-
-    /// Du's form (MODELS.md FE.5.6): l_i'' is known, so its columns move to the right-hand side
-    /// and its row becomes l_i'' = the command; ρ_i (the reel side, not modelled) stays still.
-    fn prescribe_lengths(&self, sys: &mut StarSystem, y: &[f64]) {
-        let nn = self.elements - 1;
-        sys.hold_l_rows();
-        for cable in 0..self.robot.cables() {
-            let a = self.commanded_l_acceleration(y, cable);
-            for k in cable * nn..(cable + 1) * nn {
-                sys.force[k] -= sys.l_column[k] * a;
-                sys.l_column[k] = Vector3::zeros();
-            }
-            sys.effector_force -= sys.effector_l[cable] * a;
-            sys.effector_l[cable] = Vector3::zeros();
-            sys.border[cable] = [1.0, 0.0, 1.0, a, 0.0];
-        }
-    }
-
-    /// The force each driven reel needs to impose l_i, Q_l,i = (M q'' − F)_l of the span alone
-    /// (MODELS.md FE.7: d/dt(E_span + E_P) = Σ Q_l,i l_i'), at `y` [N], assembled and solved
-    /// afresh (each right-hand side keeps its own in `prescribing`).
-    fn prescribing_forces(&self, y: &[f64]) -> Vec<f64> {
-        let (m, nn) = (self.robot.cables(), self.elements - 1);
-        let mut sys = StarSystem::new(m, nn);
-        self.assemble_into(&mut sys, y, &vec![0.0; m], false);
-        self.prescribe_lengths(&mut sys, y);
-        let mut nodes = vec![Vector3::zeros(); m * nn];
-        let (mut effector, mut border) = (Vector3::zeros(), vec![[0.0; 2]; m]);
-        let mut q = vec![f64::NAN; m];
-        if sys.solve(&mut nodes, &mut effector, &mut border) {
-            sys.held_l_residuals(&nodes, &effector, &border, &mut q);
-        }
-        q
     }
 
     /// M(q) and F(q, q', T) (FE.5.3) into `sys`: the spans, the stored elements if `stored`
