@@ -254,19 +254,16 @@ pub fn run(base: &Scenario, parts: &[Part], massive: &[f64]) -> Result<PrintStud
     };
     // The cube on the massive lines, unshaped and with the elastic study's best shaper (the
     // one a builder calibrates on the loop's modes), at the same frequencies.
-    let accelerations = massive;
+    let (accelerations, Some(cube)) = (massive, parts.first()) else {
+        return Ok(study);
+    };
     let mut massive = Vec::new();
     for (model, elements) in MASSIVE {
         let s = massive_variant(base, model, elements)?;
         for setup in SETUPS {
             for &accel in accelerations {
                 let best = study
-                    .pair(
-                        ModelKind::Elastic.name(),
-                        &parts[0].name,
-                        setup.label,
-                        accel,
-                    )
+                    .pair(ModelKind::Elastic.name(), &cube.name, setup.label, accel)
                     .map(|(_, b)| b.shaper.clone());
                 let shapers = SHAPERS
                     .iter()
@@ -275,7 +272,7 @@ pub fn run(base: &Scenario, parts: &[Part], massive: &[f64]) -> Result<PrintStud
                     massive.push((
                         s.clone(),
                         Job {
-                            part: &parts[0],
+                            part: cube,
                             setup,
                             accel,
                             shaper,
