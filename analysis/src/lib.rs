@@ -41,6 +41,10 @@ pub enum AnalysisError {
     /// Lanczos iteration).
     #[error("sparse eigen-solve near the shift: {0}")]
     Sparse(String),
+    /// The mass matrix over the free coordinates has no Cholesky factor: a free coordinate
+    /// carries no kinetic energy (it should be frozen in the model's layout).
+    #[error("the mass matrix over the free coordinates is not positive definite")]
+    MassNotPositive,
     /// The model offers no second-order form to read its mass and stiffness from.
     #[error("the model offers no second-order form (mass and stiffness matrices)")]
     NoSecondOrder,

@@ -12,7 +12,7 @@
 //! Cholesky factor, L⁻¹ K L⁻ᵀ. The dense self-adjoint eigen-solve costs O(n³): it is bounded by
 //! [`crate::linearise::DENSE_MAX_STATES`]. At any size, [`rest_modes_near`] finds the modes
 //! nearest a chosen frequency by shift-invert Lanczos ([`cdpr_numerics::lanczos`]) on the
-//! sparse K − ω_s² M, factorised once by the implicit path's sparse LU (lumped masses only).
+//! sparse K − ω_s² M, factorised once by the implicit path's sparse LU, in the M inner product.
 
 use crate::AnalysisError;
 use crate::linearise::DENSE_MAX_STATES;
@@ -114,9 +114,9 @@ fn consistent(
 ) -> Result<(Mat<f64>, Shapes), AnalysisError> {
     let restrict =
         |a: &Mat<f64>| Mat::from_fn(keep.len(), keep.len(), |r, c| a[(keep[r], keep[c])]);
-    let llt = restrict(mass).llt(Side::Lower).map_err(|e| {
-        AnalysisError::Sparse(format!("the mass matrix is not positive definite: {e:?}"))
-    })?;
+    let llt = restrict(mass)
+        .llt(Side::Lower)
+        .map_err(|_| AnalysisError::MassNotPositive)?;
     let l = llt.L().to_owned();
     let solve = |mut x: Mat<f64>| {
         faer::linalg::triangular_solve::solve_lower_triangular_in_place(
@@ -130,17 +130,6 @@ fn consistent(
     let half = solve(restrict(k).transpose().to_owned());
     let scaled = solve(half.transpose().to_owned());
     Ok((scaled, Shapes::Consistent(l)))
-}
-
-/// The diagonal of an n × n matrix given by its `pattern` and entry `values` (duplicates summed).
-fn diagonal(pattern: &[(usize, usize)], values: &[f64], n: usize) -> Vec<f64> {
-    let mut d = vec![0.0; n];
-    for (&(row, col), v) in pattern.iter().zip(values) {
-        if row == col {
-            d[row] += v;
-        }
-    }
-    d
 }
 
 /// The modes of `model` at rest in `state` (its velocities zero), the commanded `tensions` [N]
@@ -247,8 +236,9 @@ fn named(
 /// The `count` modes of `model` at rest in `state` nearest `omega` [rad/s] (numbered within
 /// their kinds among those found), at any size: K − ω²M assembled from the model's sparse
 /// iteration matrix S(c_q) = M + c_q K at c_q = −1/ω² (S = −(K − ω² M)/ω²), factorised once,
-/// and shift-invert Lanczos on M^(−1/2) K M^(−1/2) over the free coordinates (a frozen
-/// coordinate's row of S is its mass alone, so a solve leaves it at zero). `steps` Lanczos
+/// and shift-invert Lanczos on B = (K − ω² M)⁻¹ M in the M inner product over the free
+/// coordinates, lumped or consistent masses alike (a frozen coordinate's row of S is its mass
+/// alone, so a solve leaves it at zero). `steps` Lanczos
 /// steps bound the work (each one solve); the pairs' residuals are in `residuals`.
 pub fn rest_modes_near<M: CableModel<D>, const D: usize>(
     model: &mut M,
@@ -271,7 +261,6 @@ pub fn rest_modes_near<M: CableModel<D>, const D: usize>(
     let sparse = |e: cdpr_numerics::sparse::SparseError| AnalysisError::Sparse(e.to_string());
     let mut lu = IterationMatrix::new(n, &pattern).map_err(sparse)?;
     lu.factorise(&shifted).map_err(sparse)?;
-    let lanczos = |e: cdpr_numerics::lanczos::LanczosError| AnalysisError::Sparse(e.to_string());
     // M over the free coordinates, entry by entry (local row, local col, value).
     let local: Vec<Option<usize>> = (0..n).map(|i| keep.binary_search(&i).ok()).collect();
     let free_mass: Vec<(usize, usize, f64)> = pattern
@@ -279,69 +268,37 @@ pub fn rest_modes_near<M: CableModel<D>, const D: usize>(
         .zip(&mass)
         .filter_map(|(&(row, col), &v)| Some((local[row]?, local[col]?, v)))
         .collect();
-    let mut rhs = vec![0.0; n];
-    let pairs = if free_mass.iter().all(|&(r, c, v)| r == c || v == 0.0) {
-        let m = diagonal(&pattern, &mass, n);
-        // (A − ω² I)⁻¹ y = M^(1/2) (K − ω² M)⁻¹ M^(1/2) y, and (K − ω² M)⁻¹ = −S⁻¹/ω².
-        let solve = |y: &[f64], out: &mut [f64]| {
-            rhs.fill(0.0);
-            for (row, &i) in keep.iter().enumerate() {
-                rhs[i] = m[i].sqrt() * y[row];
-            }
-            lu.solve_in_place(&mut rhs);
-            for (row, &i) in keep.iter().enumerate() {
-                out[row] = -m[i].sqrt() * rhs[i] / shift;
-            }
-        };
-        let pairs = cdpr_numerics::lanczos::nearest(keep.len(), shift, count, steps, solve)
-            .map_err(lanczos)?;
-        let lumped = Shapes::Lumped(m);
-        pairs
-            .into_iter()
-            .map(|p| (p.value, lumped.physical(n, &keep, p.vector), p.residual))
-            .collect::<Vec<_>>()
-    } else {
-        // A consistent M: B = (K − ω² M)⁻¹ M in the M inner product, vectors M-normalised.
-        let product = |v: &[f64], out: &mut [f64]| {
-            out.fill(0.0);
-            for &(r, c, value) in &free_mass {
-                out[r] += value * v[c];
-            }
-        };
-        let mut my = vec![0.0; keep.len()];
-        let solve = |y: &[f64], out: &mut [f64]| {
-            product(y, &mut my);
-            rhs.fill(0.0);
-            for (row, &i) in keep.iter().enumerate() {
-                rhs[i] = my[row];
-            }
-            lu.solve_in_place(&mut rhs);
-            for (row, &i) in keep.iter().enumerate() {
-                out[row] = -rhs[i] / shift;
-            }
-        };
-        let pairs = cdpr_numerics::lanczos::nearest_with_mass(
-            keep.len(),
-            shift,
-            count,
-            steps,
-            solve,
-            product,
-        )
-        .map_err(lanczos)?;
-        pairs
-            .into_iter()
-            .map(|p| {
-                let mut u = vec![0.0; n];
-                for (row, &i) in keep.iter().enumerate() {
-                    u[i] = p.vector[row];
-                }
-                (p.value, u, p.residual)
-            })
-            .collect()
+    let product = |v: &[f64], out: &mut [f64]| {
+        out.fill(0.0);
+        for &(r, c, value) in &free_mass {
+            out[r] += value * v[c];
+        }
     };
-    let residuals = pairs.iter().map(|p| p.2).collect();
-    let (modes, effector_motion) = named(&layout, pairs.into_iter().map(|(v, u, _)| (v, u)));
+    // B y = (K − ω² M)⁻¹ M y, and (K − ω² M)⁻¹ = −S⁻¹/ω².
+    let (mut rhs, mut my) = (vec![0.0; n], vec![0.0; keep.len()]);
+    let solve = |y: &[f64], out: &mut [f64]| {
+        product(y, &mut my);
+        rhs.fill(0.0);
+        for (row, &i) in keep.iter().enumerate() {
+            rhs[i] = my[row];
+        }
+        lu.solve_in_place(&mut rhs);
+        for (row, &i) in keep.iter().enumerate() {
+            out[row] = -rhs[i] / shift;
+        }
+    };
+    let pairs =
+        cdpr_numerics::lanczos::nearest_with_mass(keep.len(), shift, count, steps, solve, product)
+            .map_err(|e| AnalysisError::Sparse(e.to_string()))?;
+    let residuals = pairs.iter().map(|p| p.residual).collect();
+    let shapes = pairs.into_iter().map(|p| {
+        let mut u = vec![0.0; n];
+        for (row, &i) in keep.iter().enumerate() {
+            u[i] = p.vector[row];
+        }
+        (p.value, u)
+    });
+    let (modes, effector_motion) = named(&layout, shapes);
     Ok((
         RestModes {
             modes,
