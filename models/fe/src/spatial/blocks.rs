@@ -271,7 +271,52 @@ impl FeSpatial {
     }
 }
 
+/// Where Du's form rewrites the element blocks' matrix ([`FeSpatial::driven_block_matrix`]),
+/// found in the pattern once: the l_i columns of the node and effector rows in the order the
+/// rewrite visits them, and in the (l_i, ρ_i) rows the l and ρ diagonals and every other entry;
+/// and the accelerations' scratch.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(super) struct DrivenSlots {
+    l_columns: Vec<usize>,
+    l_diagonal: Vec<usize>,
+    rho_diagonal: Vec<usize>,
+    off_diagonal: Vec<usize>,
+    commanded: Vec<f64>,
+}
+
 impl FeSpatial {
+    /// [`DrivenSlots`] of this model's pattern.
+    fn driven_slots(&self) -> DrivenSlots {
+        let pattern = self.iteration_pattern();
+        let slot = |row: usize, col: usize| {
+            pattern
+                .binary_search(&(row, col))
+                .expect("an l column's entry lies in the pattern")
+        };
+        let mut slots = DrivenSlots::default();
+        for cable in 0..self.robot.cables() {
+            let l = self.l_index(cable);
+            for k in 1..self.elements {
+                slots
+                    .l_columns
+                    .extend((0..3).map(|axis| slot(self.node_index(cable, k, axis), l)));
+            }
+            slots
+                .l_columns
+                .extend((0..3).map(|axis| slot(self.effector_index(axis), l)));
+        }
+        // The (l_i, ρ_i) pairs are the last coordinates.
+        let first = self.l_index(0);
+        for (e, &(row, col)) in pattern.iter().enumerate().filter(|(_, rc)| rc.0 >= first) {
+            match (col == row, (row - first).is_multiple_of(2)) {
+                (false, _) => slots.off_diagonal.push(e),
+                (true, true) => slots.l_diagonal.push(e),
+                (true, false) => slots.rho_diagonal.push(e),
+            }
+        }
+        slots
+    }
+
     /// S of Du's form (reels driven by length, MODELS.md FE.5.6) from the element blocks. Its
     /// node and effector rows are the tension form's with l_i'' = a_i(l_i', t) = l̈0_i +
     /// (l̇0_i − l_i')/τ put in: ∂/∂q and ∂/∂q' are the blocks' at q''_l = a_i (M(q)'s l
@@ -286,43 +331,43 @@ impl FeSpatial {
         (c_v, c_q): (f64, f64),
         values: &mut [f64],
     ) {
-        let mut commanded = qdd.to_vec();
-        for cable in 0..self.robot.cables() {
-            commanded[self.l_index(cable)] = self.commanded_l_acceleration(state, cable);
+        if self.driven_slots.l_columns.is_empty() {
+            self.driven_slots = self.driven_slots();
         }
-        self.block_matrix(state, &commanded, [c_q, c_v, 1.0], values);
+        let mut slots = std::mem::take(&mut self.driven_slots);
+        slots.commanded.clear();
+        slots.commanded.extend_from_slice(qdd);
+        for cable in 0..self.robot.cables() {
+            slots.commanded[self.l_index(cable)] = self.commanded_l_acceleration(state, cable);
+        }
+        self.block_matrix(state, &slots.commanded, [c_q, c_v, 1.0], values);
         let mut sys = std::mem::take(&mut self.system);
         self.assemble_into(&mut sys, state, tensions, false);
-        let pattern = self.iteration_pattern();
-        let slot = |row: usize, col: usize| {
-            pattern
-                .binary_search(&(row, col))
-                .expect("an l column's entry lies in the pattern")
-        };
         let held = 1.0 + c_v / cdpr_core::robot::reels::REEL_TIME_CONSTANT;
         let nn = self.elements - 1;
+        // M's l columns, in the order of `l_columns`: each cable's nodes, then the effector.
+        let mut slot = slots.l_columns.iter();
         for cable in 0..self.robot.cables() {
-            let l = self.l_index(cable);
-            for k in 1..self.elements {
-                let coupling = sys.l_column[cable * nn + k - 1];
+            let effector = std::iter::once(&sys.effector_l[cable]);
+            for coupling in sys.l_column[cable * nn..(cable + 1) * nn]
+                .iter()
+                .chain(effector)
+            {
                 for axis in 0..3 {
-                    values[slot(self.node_index(cable, k, axis), l)] -= held * coupling[axis];
+                    values[*slot.next().expect("a slot per coupling")] -= held * coupling[axis];
                 }
             }
-            for axis in 0..3 {
-                values[slot(self.effector_index(axis), l)] -= held * sys.effector_l[cable][axis];
+        }
+        for (list, value) in [
+            (&slots.l_diagonal, held),
+            (&slots.rho_diagonal, 1.0),
+            (&slots.off_diagonal, 0.0),
+        ] {
+            for &e in list {
+                values[e] = value;
             }
         }
-        // The (l_i, ρ_i) pairs are the last coordinates.
-        let first = self.l_index(0);
-        for (e, &(row, col)) in pattern.iter().enumerate().filter(|(_, rc)| rc.0 >= first) {
-            let diagonal = if (row - first).is_multiple_of(2) {
-                held
-            } else {
-                1.0
-            };
-            values[e] = if col == row { diagonal } else { 0.0 };
-        }
         self.system = sys;
+        self.driven_slots = slots;
     }
 }

@@ -49,6 +49,8 @@ pub struct FeSpatial {
     /// Where the element blocks' entries go in the iteration pattern (built at the first
     /// element-by-element matrix, [`blocks`]).
     block_slots: Vec<usize>,
+    /// Where Du's form rewrites them, and its scratch ([`blocks::DrivenSlots`]).
+    driven_slots: blocks::DrivenSlots,
     /// Reels driven by length (the scenario's `length` controller): the free lengths l_i are
     /// prescribed (MODELS.md FE.5.6, Du's form), the stored cable is on the reel and not
     /// modelled; `drive` holds the commanded (l̇0_i, l̈0_i) from the last
@@ -140,6 +142,7 @@ impl FeSpatial {
             border_accelerations: vec![[0.0; 2]; m],
             differences: None,
             block_slots: Vec::new(),
+            driven_slots: blocks::DrivenSlots::default(),
             length_driven: false,
             drive: None,
             prescribing: vec![0.0; m],
