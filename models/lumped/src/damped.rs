@@ -14,6 +14,7 @@
 //! planar one and the spatial one, take their blocks here.
 
 use crate::spring_tension;
+use cdpr_numerics::differences::CBRT_EPSILON;
 use nalgebra::{SMatrix, SVector};
 
 /// A spring's end-force derivatives in the order (a, a), (a, b), (b, a), (b, b): by position
@@ -151,4 +152,21 @@ pub(crate) fn smooth_reach((k, l0, c): (f64, f64, f64), length: f64, rate: f64) 
         return reach;
     }
     reach.min(0.25 * ((k * stretch + c * rate) / k).abs())
+}
+
+/// The reach ([`smooth_reach`]) of a chain's spring and, where it straddles a pulley (`straddle`:
+/// the pulley and the spring's two ends), at most ε^(1/3) of each end's distance d to it: the
+/// path's direction turns on the scale d (truncation (δ/d)² ≈ 4e-11).
+pub(crate) fn chain_reach<const D: usize>(
+    spring: (f64, f64, f64),
+    (length, rate): (f64, f64),
+    straddle: Option<(SVector<f64, D>, [SVector<f64, D>; 2])>,
+) -> f64 {
+    let mut limit = smooth_reach(spring, length, rate);
+    if let Some((pulley, ends)) = straddle {
+        for end in ends {
+            limit = limit.min(CBRT_EPSILON * (end - pulley).norm());
+        }
+    }
+    limit
 }

@@ -12,7 +12,7 @@
 use crate::Lumped;
 use crate::damped::{AtPulley, SpringBlocks, damped_blocks, undamped_blocks};
 use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
-use cdpr_numerics::differences::{CBRT_EPSILON, ColouredDifferences};
+use cdpr_numerics::differences::ColouredDifferences;
 
 /// Buffers of the second-order form (allocated once per model).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -256,14 +256,11 @@ impl SecondOrderForm for Lumped {
                     (length, rate)
                 };
                 let spring = (self.stiffness, self.segment, self.damping);
-                let mut limit = crate::damped::smooth_reach(spring, length, rate);
-                if j + 1 == r {
-                    let pulley = self.pulley(cable);
-                    for node in [j, j + 1] {
-                        let d = (self.node(state, cable, node) - pulley).norm();
-                        limit = limit.min(CBRT_EPSILON * d);
-                    }
-                }
+                let straddle = (j + 1 == r).then(|| {
+                    let ends = [j, j + 1].map(|node| self.node(state, cable, node));
+                    (self.pulley(cable), ends)
+                });
+                let limit = crate::damped::chain_reach(spring, (length, rate), straddle);
                 for node in [j, j + 1] {
                     for i in self.coordinates(cable, node) {
                         out[i] = out[i].min(limit);

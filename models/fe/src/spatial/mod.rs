@@ -7,7 +7,8 @@
 //! Generalised coordinates: per cable i its free nodes k = 1 … N − 1 (x, y, z each, cable-major),
 //! then P, then per cable (l_i, ρ_i); n = 3m(N − 1) + 3 + 2m, the state (q, q'). M q'' = F is
 //! solved on the star of arms in O(N m) ([`star`]); the implicit path's form is [`implicit`];
-//! reels driven by length prescribe l_i ([`prescribed`]). The stored cable is elastic (FE.1.3's reference variant); the rigid variant is planar only.
+//! reels driven by length prescribe l_i ([`prescribed`]). The stored cable is elastic (FE.1.3's
+//! reference variant); the rigid variant is planar only.
 
 mod blocks;
 mod implicit;

@@ -140,8 +140,9 @@ pub(super) fn equilibrium(
     let first = model.effector_index(0);
     let force = map.len();
     let rho_rows = model.tension_rows();
+    let dynamic = model.iteration_pattern();
     let mut pattern = statics::pattern_from_dynamics(
-        &model.iteration_pattern(),
+        &dynamic,
         Some,
         |j| match j {
             _ if j < first => Some(j),
@@ -157,7 +158,7 @@ pub(super) fn equilibrium(
             .extend(rho_rows.iter().map(|&row| (row, force + axis)));
     }
     let mut problem = Problem {
-        stiffness: vec![0.0; model.iteration_pattern().len()],
+        stiffness: vec![0.0; dynamic.len()],
         at_rest: vec![0.0; np],
         model,
         pose,

@@ -13,7 +13,7 @@
 use super::LumpedSpatial;
 use cdpr_core::model::CableModel;
 use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
-use cdpr_numerics::differences::{CBRT_EPSILON, ColouredDifferences};
+use cdpr_numerics::differences::ColouredDifferences;
 use nalgebra::Matrix3;
 
 /// The refresh rule's price of an analytic matrix, in Newton iterations (the planar lumped
@@ -238,14 +238,11 @@ impl SecondOrderForm for LumpedSpatial {
                     (length, rate)
                 };
                 let spring = (self.stiffness, self.segment, self.damping);
-                let mut limit = crate::damped::smooth_reach(spring, length, rate);
-                if j + 1 == r {
-                    let pulley = self.pulley(cable);
-                    for node in [j, j + 1] {
-                        let d = (self.node(state, cable, node) - pulley).norm();
-                        limit = limit.min(CBRT_EPSILON * d);
-                    }
-                }
+                let straddle = (j + 1 == r).then(|| {
+                    let ends = [j, j + 1].map(|node| self.node(state, cable, node));
+                    (self.pulley(cable), ends)
+                });
+                let limit = crate::damped::chain_reach(spring, (length, rate), straddle);
                 for node in [j, j + 1] {
                     for axis in 0..3 {
                         let i = self.index(cable, node, axis);
