@@ -269,6 +269,31 @@ fn the_move_balances_energy_and_rests_as_the_lumped_lines() {
     }
 }
 
+/// FE.5.7 asks that the axial damping's terms be checked by the dissipation identity before
+/// they are relied on, and the print example's lines carry C = 8.5 N s: the Hangprinter move
+/// (0.4 s, DOPRI5 at the default tolerances) on damped FE lines closes dE/dt = Σ T_i ρ_i' − D
+/// to 1e-6 J, as the undamped move, while the damping dissipates D > 1e-4 J — a hundred times
+/// the bound, so leaving D out of the balance (or a damping force that does not dissipate it)
+/// fails.
+#[test]
+fn the_damped_move_balances_energy_with_its_dissipation() {
+    use cdpr_bench::core::channel::Channel;
+    let mut s = short(hangprinter(10, 970.0));
+    s.cable.axial_damping = 8.5;
+    let fe = run(&s);
+    let dissipated = *fe
+        .run
+        .series
+        .column(Channel::EDissipated)
+        .unwrap()
+        .last()
+        .unwrap();
+    let residual = fe.metrics.energy_residual_max;
+    eprintln!("damped move: dissipated {dissipated:e} J, residual {residual:e} J");
+    assert!(residual < 1e-6, "{residual:e} J");
+    assert!(dissipated > 1e-4, "dissipated {dissipated:e} J");
+}
+
 /// As the lines' mass vanishes the FE robot's move tends to the massless elastic cables':
 /// the largest distance between the two effector paths halves with the density (ratio within
 /// [0.4, 0.6]: the lines' inertia and weight act at first order in μ).
