@@ -79,30 +79,9 @@ impl SpatialMetrics {
         let s = &run.series;
         let column = |c: Channel| s.channel(c).unwrap_or(&[]);
         let t = column(Channel::Time);
-        let x_ref = column(Channel::XRef);
         let m = run.equilibrium.tensions.len();
-        let start = positions(run)
-            .next()
-            .map_or(Vector::<3>::repeat(f64::NAN), |(_, p)| p);
-        let error: Vec<f64> = positions(run)
-            .enumerate()
-            .map(|(i, (ti, p))| {
-                let reference = match &context.path {
-                    Some(path) => path.shaped(context.shaper.as_ref(), ti, false)[0],
-                    None => Vector::<3>::new(x_ref[i], start[1], start[2]),
-                };
-                (reference - p).norm()
-            })
-            .collect();
-        let window_max = |from: f64, to: f64| {
-            // The whole window recorded (to a picosecond of the sample grid).
-            let reached = t.last().is_some_and(|&end| end >= to - 1e-12);
-            let r = t.partition_point(|&v| v < from)..t.partition_point(|&v| v <= to);
-            if !reached || r.is_empty() {
-                return f64::NAN;
-            }
-            error[r].iter().copied().fold(0.0, f64::max)
-        };
+        let error = path_errors(run, context, column(Channel::XRef));
+        let window_max = |from: f64, to: f64| max_error_in(t, &error, from, to);
         let t_end = t.last().copied().unwrap_or(0.0);
         let tensions: Vec<&[f64]> = CableId::all(m)
             .map(|c| column(Channel::Tension(c)))
@@ -119,16 +98,7 @@ impl SpatialMetrics {
         let saturated = column(Channel::Saturated);
         let saturated_s = saturated.iter().filter(|&&v| v != 0.0).count() as f64
             * t.get(1).map_or(0.0, |t1| t1 - t[0]);
-        // The paid-out unstrained length: the elastic model's l0_i, a massive model's free
-        // unstrained length l_free_i (its rate is the cable's passage over the pulley).
-        let reel_speed_max = (1..=m)
-            .map(|i| {
-                let paid_out = s
-                    .channel_named(&format!("l0_{i}"))
-                    .or_else(|| s.channel_named(&format!("l_free_{i}")));
-                max_rate(t, paid_out.unwrap_or(&[]))
-            })
-            .collect();
+        let reel_speed_max = reel_speeds(run, t, m);
         let after = context.move_end + 1.0;
         Self {
             controller: context.controller,
@@ -158,6 +128,49 @@ impl SpatialMetrics {
             pulley_events: run.events.len(),
         }
     }
+}
+
+/// The path error |p_ref − p| [m] at each sample, against the (shaped) move or the plane's x_ref.
+fn path_errors(run: &Run, context: &SpatialContext, x_ref: &[f64]) -> Vec<f64> {
+    let start = positions(run)
+        .next()
+        .map_or(Vector::<3>::repeat(f64::NAN), |(_, p)| p);
+    positions(run)
+        .enumerate()
+        .map(|(i, (ti, p))| {
+            let reference = match &context.path {
+                Some(path) => path.shaped(context.shaper.as_ref(), ti, false)[0],
+                None => Vector::<3>::new(x_ref[i], start[1], start[2]),
+            };
+            (reference - p).norm()
+        })
+        .collect()
+}
+
+/// The largest path error over [from, to] [s]; NaN where the record does not reach the window.
+fn max_error_in(t: &[f64], error: &[f64], from: f64, to: f64) -> f64 {
+    // The whole window recorded (to a picosecond of the sample grid).
+    let reached = t.last().is_some_and(|&end| end >= to - 1e-12);
+    let r = t.partition_point(|&v| v < from)..t.partition_point(|&v| v <= to);
+    if !reached || r.is_empty() {
+        return f64::NAN;
+    }
+    error[r].iter().copied().fold(0.0, f64::max)
+}
+
+/// Each reel's largest paying-out speed [m/s] over the run, cable 1 first.
+fn reel_speeds(run: &Run, t: &[f64], m: usize) -> Vec<f64> {
+    let s = &run.series;
+    // The paid-out unstrained length: the elastic model's l0_i, a massive model's free
+    // unstrained length l_free_i (its rate is the cable's passage over the pulley).
+    (1..=m)
+        .map(|i| {
+            let paid_out = s
+                .channel_named(&format!("l0_{i}"))
+                .or_else(|| s.channel_named(&format!("l_free_{i}")));
+            max_rate(t, paid_out.unwrap_or(&[]))
+        })
+        .collect()
 }
 
 /// max |dv/dt| of samples `v` at times `t`, by central differences (one-sided at the ends).

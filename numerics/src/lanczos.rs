@@ -63,53 +63,10 @@ pub fn nearest_with_mass(
         return Err(LanczosError::Count { count, n });
     }
     let steps = steps.clamp(count, n);
-    let (mut basis, mut products): (Vec<Vec<f64>>, Vec<Vec<f64>>) =
-        (Vec::with_capacity(steps + 1), Vec::with_capacity(steps + 1));
-    let mut start: Vec<f64> = (0..n)
-        .map(|i| ((i as f64 + 1.0) * 0.618_033_988_749_894_9).fract() - 0.5)
-        .collect();
-    let mut product = vec![0.0; n];
-    mass(&start, &mut product);
-    let norm = dot(&start, &product).sqrt();
-    start.iter_mut().for_each(|x| *x /= norm);
-    product.iter_mut().for_each(|x| *x /= norm);
-    basis.push(start);
-    products.push(product);
-    let (mut alpha, mut beta) = (Vec::with_capacity(steps), Vec::with_capacity(steps));
-    let (mut w, mut mw) = (vec![0.0; n], vec![0.0; n]);
-    for k in 0..steps {
-        solve(&basis[k], &mut w);
-        let a = dot(&w, &products[k]);
-        alpha.push(a);
-        // Full reorthogonalisation, twice (Kahan's "twice is enough").
-        for _ in 0..2 {
-            for (v, mv) in basis.iter().zip(&products) {
-                let c = dot(&w, mv);
-                w.iter_mut().zip(v).for_each(|(w, v)| *w -= c * v);
-            }
-        }
-        mass(&w, &mut mw);
-        let b = dot(&w, &mw).sqrt();
-        beta.push(b);
-        if b <= 1e-14 * a.abs().max(f64::MIN_POSITIVE) || k + 1 == steps {
-            break;
-        }
-        basis.push(w.iter().map(|v| v / b).collect());
-        products.push(mw.iter().map(|v| v / b).collect());
-    }
+    let mut mw = vec![0.0; n];
+    let (basis, alpha, beta) = krylov(n, steps, &mut solve, &mut mass, &mut mw);
     let k = alpha.len();
-    let tridiagonal = Mat::from_fn(k, k, |i, j| {
-        if i == j {
-            alpha[i]
-        } else if i + 1 == j {
-            beta[i]
-        } else if j + 1 == i {
-            beta[j]
-        } else {
-            0.0
-        }
-    });
-    let evd = tridiagonal
+    let evd = tridiagonal(&alpha, &beta)
         .self_adjoint_eigen(Side::Lower)
         .map_err(|_| LanczosError::Tridiagonal)?;
     let (theta, s) = (evd.S().column_vector(), evd.U());
@@ -137,6 +94,73 @@ pub fn nearest_with_mass(
         .collect();
     pairs.sort_by(|a, b| a.value.total_cmp(&b.value));
     Ok(pairs)
+}
+
+/// The fixed pseudo-random start vector, M-normalised, and its M v (same inputs, same pairs).
+fn start_vector(n: usize, mass: &mut impl FnMut(&[f64], &mut [f64])) -> (Vec<f64>, Vec<f64>) {
+    let mut start: Vec<f64> = (0..n)
+        .map(|i| ((i as f64 + 1.0) * 0.618_033_988_749_894_9).fract() - 0.5)
+        .collect();
+    let mut product = vec![0.0; n];
+    mass(&start, &mut product);
+    let norm = dot(&start, &product).sqrt();
+    start.iter_mut().for_each(|x| *x /= norm);
+    product.iter_mut().for_each(|x| *x /= norm);
+    (start, product)
+}
+
+/// The Lanczos steps in the M inner product: the M-orthonormal basis and the tridiagonal's α, β.
+fn krylov(
+    n: usize,
+    steps: usize,
+    solve: &mut impl FnMut(&[f64], &mut [f64]),
+    mass: &mut impl FnMut(&[f64], &mut [f64]),
+    mw: &mut [f64],
+) -> (Vec<Vec<f64>>, Vec<f64>, Vec<f64>) {
+    let (mut basis, mut products): (Vec<Vec<f64>>, Vec<Vec<f64>>) =
+        (Vec::with_capacity(steps + 1), Vec::with_capacity(steps + 1));
+    let (start, product) = start_vector(n, mass);
+    basis.push(start);
+    products.push(product);
+    let (mut alpha, mut beta) = (Vec::with_capacity(steps), Vec::with_capacity(steps));
+    let mut w = vec![0.0; n];
+    for k in 0..steps {
+        solve(&basis[k], &mut w);
+        let a = dot(&w, &products[k]);
+        alpha.push(a);
+        // Full reorthogonalisation, twice (Kahan's "twice is enough").
+        for _ in 0..2 {
+            for (v, mv) in basis.iter().zip(&products) {
+                let c = dot(&w, mv);
+                w.iter_mut().zip(v).for_each(|(w, v)| *w -= c * v);
+            }
+        }
+        mass(&w, mw);
+        let b = dot(&w, mw).sqrt();
+        beta.push(b);
+        if b <= 1e-14 * a.abs().max(f64::MIN_POSITIVE) || k + 1 == steps {
+            break;
+        }
+        basis.push(w.iter().map(|v| v / b).collect());
+        products.push(mw.iter().map(|v| v / b).collect());
+    }
+    (basis, alpha, beta)
+}
+
+/// The Lanczos tridiagonal T: α on the diagonal, β beside it (B's projection on the basis).
+fn tridiagonal(alpha: &[f64], beta: &[f64]) -> Mat<f64> {
+    let k = alpha.len();
+    Mat::from_fn(k, k, |i, j| {
+        if i == j {
+            alpha[i]
+        } else if i + 1 == j {
+            beta[i]
+        } else if j + 1 == i {
+            beta[j]
+        } else {
+            0.0
+        }
+    })
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {

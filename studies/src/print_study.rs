@@ -512,8 +512,47 @@ impl PrintStudy {
             .chain(MASSIVE.map(|(m, _)| m))
             .map(|m| m.name())
             .collect();
-        let cell = |model: &str, setup: &str, accel: f64| match self.pair(model, part, setup, accel)
-        {
+        let mut md = format!(
+            "**{part} on every cable model** (lumped lines of {} springs and FE cables of {} \
+             elements on the implicit path, h = 1e-4 s) — the printing moves' largest contour \
+             error [µm], unshaped / with the elastic study's best shaper at its frequencies\n\n\
+             | controller | accel [mm/s²] | {} |\n|---|---:|{}\n",
+            MASSIVE[0].1,
+            MASSIVE[1].1,
+            models.join(" | "),
+            "---:|".repeat(models.len())
+        );
+        let accelerations = self.massive_accelerations();
+        for setup in SETUPS {
+            for &accel in &accelerations {
+                let cells: Vec<String> = models
+                    .iter()
+                    .map(|m| self.massive_cell(m, part, setup.label, accel))
+                    .collect();
+                let _ = writeln!(
+                    md,
+                    "| {} | {accel:.0} | {} |",
+                    setup.label,
+                    cells.join(" | ")
+                );
+            }
+        }
+        let knees = self.massive_knees(&models, part);
+        if accelerations.len() == ACCELERATIONS.len() {
+            let _ = writeln!(
+                md,
+                "\nKnees, unshaped / best-shaped — {}\n",
+                knees.join(". ")
+            );
+        } else {
+            md.push('\n');
+        }
+        md
+    }
+
+    /// One every-model table cell: largest printing contour error [µm] unshaped / shaped, or why none.
+    fn massive_cell(&self, model: &str, part: &str, setup: &str, accel: f64) -> String {
+        match self.pair(model, part, setup, accel) {
             Some((u, b)) => format!(
                 "{:.1} / {:.1}",
                 u.contour_err_max_printing * 1e6,
@@ -532,17 +571,11 @@ impl PrintStudy {
                     "—".into()
                 }
             }
-        };
-        let mut md = format!(
-            "**{part} on every cable model** (lumped lines of {} springs and FE cables of {} \
-             elements on the implicit path, h = 1e-4 s) — the printing moves' largest contour \
-             error [µm], unshaped / with the elastic study's best shaper at its frequencies\n\n\
-             | controller | accel [mm/s²] | {} |\n|---|---:|{}\n",
-            MASSIVE[0].1,
-            MASSIVE[1].1,
-            models.join(" | "),
-            "---:|".repeat(models.len())
-        );
+        }
+    }
+
+    /// The accelerations the massive cable models printed at, ascending and without repeats.
+    fn massive_accelerations(&self) -> Vec<f64> {
         let mut accelerations: Vec<f64> = self
             .rows
             .iter()
@@ -551,19 +584,12 @@ impl PrintStudy {
             .collect();
         accelerations.sort_by(f64::total_cmp);
         accelerations.dedup();
-        for setup in SETUPS {
-            for &accel in &accelerations {
-                let cells: Vec<String> =
-                    models.iter().map(|m| cell(m, setup.label, accel)).collect();
-                let _ = writeln!(
-                    md,
-                    "| {} | {accel:.0} | {} |",
-                    setup.label,
-                    cells.join(" | ")
-                );
-            }
-        }
-        let knees: Vec<String> = models
+        accelerations
+    }
+
+    /// Each cable model's knees per setup, unshaped / best-shaped ("model: setup u / b; …").
+    fn massive_knees(&self, models: &[&str], part: &str) -> Vec<String> {
+        models
             .iter()
             .map(|m| {
                 let per: Vec<String> = SETUPS
@@ -577,16 +603,6 @@ impl PrintStudy {
                     .collect();
                 format!("{m}: {}", per.join("; "))
             })
-            .collect();
-        if accelerations.len() == ACCELERATIONS.len() {
-            let _ = writeln!(
-                md,
-                "\nKnees, unshaped / best-shaped — {}\n",
-                knees.join(". ")
-            );
-        } else {
-            md.push('\n');
-        }
-        md
+            .collect()
     }
 }

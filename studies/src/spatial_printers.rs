@@ -7,7 +7,7 @@
 //! The cable models in space are the massless elastic cables, the lumped lines and the FE
 //! cables (MODELS.md §11); the maps' FE columns are FE cables of [`FE_ELEMENTS`] elements.
 
-use crate::spatial_modes::{Lines, SpatialLoop, at_pose, locked_line_modes};
+use crate::spatial_modes::{Lines, SpatialLoop, SpatialMode, at_pose, locked_line_modes};
 use crate::spatial_moves::{MoveRow, table_with};
 use crate::{Result, StudyError};
 use cdpr_bench::ModelKind;
@@ -112,63 +112,7 @@ pub fn mode_map(
         .map_err(|e| StudyError::Failed(format!("the lumped lines: {e}")))?;
     let fe_scenario = fe_variant(scenario)?;
     let targets = crate::flex_error::grid(low, high, per_axis);
-    let rows = crate::pool::map(&targets, |p| -> Result<Option<ModePoint>> {
-        let Some(tensions) = crate::flex_error::rest_tensions(scenario, model.robot(), p) else {
-            return Ok(None);
-        };
-        let modes = at_pose(scenario, [p.x, p.y, p.z])?.modes;
-        let same_length = same_length_lowest(&model, p, &tensions)?;
-        let lowest = |keep: &dyn Fn(&crate::spatial_modes::SpatialMode) -> bool| {
-            modes
-                .iter()
-                .filter(|m| keep(m))
-                .map(|m| m.omega_rad_s)
-                .min_by(f64::total_cmp)
-        };
-        let lumped: Vec<&crate::spatial_modes::SpatialMode> = modes
-            .iter()
-            .filter(|m| m.linearisation == SpatialLoop::LumpedLockedReels)
-            .collect();
-        let share = |m: &crate::spatial_modes::SpatialMode| m.effector_share.unwrap_or(0.0);
-        let effector = effector_mode(lumped.iter().copied());
-        let fe = locked_line_modes(&fe_scenario, Lines::Fe(FE_ELEMENTS), p, &tensions, 0.0)?;
-        let fe_same_length_rad_s = fe_same_length_lowest(&fe_scenario, p, &tensions)?;
-        let fe_effector = effector_mode(fe.iter());
-        let strings = |modes: &mut dyn Iterator<Item = &crate::spatial_modes::SpatialMode>| {
-            modes
-                .filter(|m| matches!(m.kind, Some(ModeKind::InPlane(_) | ModeKind::OutOfPlane(_))))
-                .map(|m| m.omega_rad_s)
-                .min_by(f64::total_cmp)
-        };
-        let share_below = lumped
-            .iter()
-            .filter(|m| effector.is_some_and(|e| m.omega_rad_s < e.omega_rad_s))
-            .map(|m| share(m))
-            .fold(0.0, f64::max);
-        let missing = |what: &str| {
-            StudyError::Failed(format!("modes at {:?} m: no {what} mode", p.as_slice()))
-        };
-        Ok(Some(ModePoint {
-            pose: [p.x, p.y, p.z],
-            tensions,
-            elastic_tension_reels_rad_s: lowest(&|m| m.linearisation == SpatialLoop::TensionReels)
-                .ok_or_else(|| missing("tension-reel"))?,
-            elastic_locked_rad_s: lowest(&|m| m.linearisation == SpatialLoop::LockedReels)
-                .ok_or_else(|| missing("locked-reel"))?,
-            elastic_same_length_rad_s: same_length,
-            lumped_locked_rad_s: effector.map(|m| m.omega_rad_s),
-            lumped_locked_share: effector.map(share),
-            lowest_string_rad_s: lowest(&|m| {
-                m.linearisation == SpatialLoop::LumpedLockedReels
-                    && matches!(m.kind, Some(ModeKind::InPlane(_) | ModeKind::OutOfPlane(_)))
-            }),
-            share_below,
-            fe_locked_rad_s: fe_effector.map(|m| m.omega_rad_s),
-            fe_locked_share: fe_effector.map(share),
-            fe_same_length_rad_s,
-            fe_lowest_string_rad_s: strings(&mut fe.iter()),
-        }))
-    })?;
+    let rows = crate::pool::map(&targets, |p| mode_point(scenario, &model, &fe_scenario, p))?;
     let (points, infeasible) = crate::flex_error::feasible(rows)?;
     Ok(ModeMap {
         elements,
@@ -179,6 +123,76 @@ pub fn mode_map(
         infeasible,
         points,
     })
+}
+
+/// One grid target's modes on every cable model at rest there (None: no tensions hold it).
+fn mode_point(
+    scenario: &Scenario,
+    model: &LumpedSpatial,
+    fe_scenario: &Scenario,
+    p: &Vector<3>,
+) -> Result<Option<ModePoint>> {
+    let Some(tensions) = crate::flex_error::rest_tensions(scenario, model.robot(), p) else {
+        return Ok(None);
+    };
+    let modes = at_pose(scenario, [p.x, p.y, p.z])?.modes;
+    let same_length = same_length_lowest(model, p, &tensions)?;
+    let lowest = |keep: &dyn Fn(&SpatialMode) -> bool| {
+        modes
+            .iter()
+            .filter(|m| keep(m))
+            .map(|m| m.omega_rad_s)
+            .min_by(f64::total_cmp)
+    };
+    let lumped: Vec<&SpatialMode> = modes
+        .iter()
+        .filter(|m| m.linearisation == SpatialLoop::LumpedLockedReels)
+        .collect();
+    let share = |m: &SpatialMode| m.effector_share.unwrap_or(0.0);
+    let effector = effector_mode(lumped.iter().copied());
+    let fe = locked_line_modes(fe_scenario, Lines::Fe(FE_ELEMENTS), p, &tensions, 0.0)?;
+    let fe_same_length_rad_s = fe_same_length_lowest(fe_scenario, p, &tensions)?;
+    let fe_effector = effector_mode(fe.iter());
+    let share_below = share_below(&lumped, effector);
+    let missing =
+        |what: &str| StudyError::Failed(format!("modes at {:?} m: no {what} mode", p.as_slice()));
+    Ok(Some(ModePoint {
+        pose: [p.x, p.y, p.z],
+        tensions,
+        elastic_tension_reels_rad_s: lowest(&|m| m.linearisation == SpatialLoop::TensionReels)
+            .ok_or_else(|| missing("tension-reel"))?,
+        elastic_locked_rad_s: lowest(&|m| m.linearisation == SpatialLoop::LockedReels)
+            .ok_or_else(|| missing("locked-reel"))?,
+        elastic_same_length_rad_s: same_length,
+        lumped_locked_rad_s: effector.map(|m| m.omega_rad_s),
+        lumped_locked_share: effector.map(share),
+        lowest_string_rad_s: lowest(&|m| {
+            m.linearisation == SpatialLoop::LumpedLockedReels
+                && matches!(m.kind, Some(ModeKind::InPlane(_) | ModeKind::OutOfPlane(_)))
+        }),
+        share_below,
+        fe_locked_rad_s: fe_effector.map(|m| m.omega_rad_s),
+        fe_locked_share: fe_effector.map(share),
+        fe_same_length_rad_s,
+        fe_lowest_string_rad_s: lowest_string(&mut fe.iter()),
+    }))
+}
+
+/// How much the strings below the lumped lines' effector mode move it: their largest share.
+fn share_below(lumped: &[&SpatialMode], effector: Option<&SpatialMode>) -> f64 {
+    lumped
+        .iter()
+        .filter(|m| effector.is_some_and(|e| m.omega_rad_s < e.omega_rad_s))
+        .map(|m| m.effector_share.unwrap_or(0.0))
+        .fold(0.0, f64::max)
+}
+
+/// The lowest string mode [rad/s] among `modes`: any line's, in or across its vertical plane.
+fn lowest_string(modes: &mut dyn Iterator<Item = &SpatialMode>) -> Option<f64> {
+    modes
+        .filter(|m| matches!(m.kind, Some(ModeKind::InPlane(_) | ModeKind::OutOfPlane(_))))
+        .map(|m| m.omega_rad_s)
+        .min_by(f64::total_cmp)
 }
 
 /// The lowest effector mode [rad/s] on massless elastic lines locked at the lengths the lumped

@@ -132,28 +132,7 @@ enum Command {
     /// The static equilibrium (MODELS.md §2) at every start of an x × ΣT grid (cell midpoints);
     /// prints the starts that fail and exits non-zero if any does. The defaults are the lumped
     /// property test's ranges at 2000 × 250 points (~2 min for lumped or FE).
-    StaticsSweep {
-        /// Scenario file (TOML, MODELS.md §9); absent = the paper's scenario.
-        #[arg(long)]
-        scenario: Option<PathBuf>,
-        /// Cable model, overriding the scenario's [model] kind.
-        #[arg(long, value_enum)]
-        model: Option<ModelKind>,
-        /// Effector x range [m] and its number of points.
-        #[arg(long, default_value_t = 0.15)]
-        x_min: f64,
-        #[arg(long, default_value_t = 0.85)]
-        x_max: f64,
-        #[arg(long, default_value_t = 2000)]
-        x_steps: usize,
-        /// Tension sum ΣT range [N] and its number of points.
-        #[arg(long, default_value_t = 120.0)]
-        tension_min: f64,
-        #[arg(long, default_value_t = 400.0)]
-        tension_max: f64,
-        #[arg(long, default_value_t = 250)]
-        tension_steps: usize,
-    },
+    StaticsSweep(statics_sweep::Args),
     /// The firmware's motion plan of a G-code file (Klipper's planner, `[printer]` limits)
     /// → DIR/plan.csv, one row per moving segment in the robot's frame.
     Plan {
@@ -355,28 +334,6 @@ fn run(command: Command) -> anyhow::Result<()> {
             Some(grid) => sweep::run(&grid, &out, jobs, shard.unwrap_or(cdpr_sweep::Shard::ALL)),
             None => sweep::merge(&merge, &out),
         },
-        Command::StaticsSweep {
-            scenario,
-            model,
-            x_min,
-            x_max,
-            x_steps,
-            tension_min,
-            tension_max,
-            tension_steps,
-        } => statics_sweep::run(
-            scenario.as_deref(),
-            model,
-            statics_sweep::Axis {
-                min: x_min,
-                max: x_max,
-                steps: x_steps,
-            },
-            statics_sweep::Axis {
-                min: tension_min,
-                max: tension_max,
-                steps: tension_steps,
-            },
-        ),
+        Command::StaticsSweep(args) => statics_sweep::run(&args),
     }
 }

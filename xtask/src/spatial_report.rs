@@ -224,17 +224,42 @@ fn draw_move(p: &Printer, s: &Scenario, out: &Path) -> Result<String> {
 /// effector mode on the elastic and on the lumped lines and the lines' lowest string mode
 /// (DIR/spatial_KEY_modes), and the flex-compensation error (DIR/spatial_KEY_flex).
 fn draw_maps(p: &Printer, modes: &ModeMap, flex: &FlexError, out: &Path) -> Result<()> {
-    let n = modes.per_axis;
-    let coord = |axis: usize, k: usize| {
+    let grid = MapGrid {
+        p,
+        n: modes.per_axis,
+    };
+    let layers = [0, grid.n / 2, grid.n - 1];
+    draw_mode_maps(&grid, &layers, modes, out)?;
+    draw_flex_maps(&grid, &layers, flex, out)
+}
+
+/// The maps' grid over a printer's build volume: `n` points per axis, low corner to high.
+struct MapGrid<'a> {
+    p: &'a Printer,
+    n: usize,
+}
+
+impl MapGrid<'_> {
+    /// The coordinate [m] of the `k`-th grid point along `axis` (the box's centre if one point).
+    fn coord(&self, axis: usize, k: usize) -> f64 {
+        let (p, n) = (self.p, self.n);
         if n > 1 {
             p.low[axis] + k as f64 * (p.high[axis] - p.low[axis]) / (n - 1) as f64
         } else {
             0.5 * (p.low[axis] + p.high[axis])
         }
-    };
-    let labels = |axis: usize| (0..n).map(|k| format!("{:.2}", coord(axis, k))).collect();
-    let layers = [0, n / 2, n - 1];
-    let index = |pose: [f64; 3]| -> [usize; 3] {
+    }
+
+    /// The tick labels along `axis`: each grid point's coordinate [m].
+    fn labels(&self, axis: usize) -> Vec<String> {
+        (0..self.n)
+            .map(|k| format!("{:.2}", self.coord(axis, k)))
+            .collect()
+    }
+
+    /// The grid point a study's pose [m] lies on, as indices per axis.
+    fn index(&self, pose: [f64; 3]) -> [usize; 3] {
+        let (p, n) = (self.p, self.n);
         std::array::from_fn(|a| {
             let span = p.high[a] - p.low[a];
             if span > 0.0 && n > 1 {
@@ -243,30 +268,46 @@ fn draw_maps(p: &Printer, modes: &ModeMap, flex: &FlexError, out: &Path) -> Resu
                 0
             }
         })
-    };
-    let panel = |title: String, values: &dyn Fn(usize, usize) -> Option<f64>| HeatPanel {
-        title,
-        x_labels: labels(0),
-        y_labels: labels(1),
-        values: (0..n)
-            .map(|iy| (0..n).map(|ix| values(ix, iy)).collect())
-            .collect(),
-    };
+    }
+
+    /// One layer's panel over x and y of `values` at each grid point (None: nothing there).
+    fn panel(&self, title: String, values: &dyn Fn(usize, usize) -> Option<f64>) -> HeatPanel {
+        let n = self.n;
+        HeatPanel {
+            title,
+            x_labels: self.labels(0),
+            y_labels: self.labels(1),
+            values: (0..n)
+                .map(|iy| (0..n).map(|ix| values(ix, iy)).collect())
+                .collect(),
+        }
+    }
+}
+
+/// Per layer, the lowest effector mode (elastic, lumped) and string mode (DIR/spatial_KEY_modes).
+fn draw_mode_maps(grid: &MapGrid, layers: &[usize; 3], modes: &ModeMap, out: &Path) -> Result<()> {
+    let p = grid.p;
     let hz = |w: f64| w / (2.0 * std::f64::consts::PI);
-    let mode_at =
-        |ix: usize, iy: usize, l: usize| modes.points.iter().find(|q| index(q.pose) == [ix, iy, l]);
+    let mode_at = |ix: usize, iy: usize, l: usize| {
+        modes
+            .points
+            .iter()
+            .find(|q| grid.index(q.pose) == [ix, iy, l])
+    };
     let mut panels = Vec::new();
-    for &l in &layers {
-        let z = coord(2, l);
-        panels.push(panel(format!("elastic, z = {z:.2} m"), &|ix, iy| {
+    for &l in layers {
+        let z = grid.coord(2, l);
+        panels.push(grid.panel(format!("elastic, z = {z:.2} m"), &|ix, iy| {
             mode_at(ix, iy, l).map(|q| hz(q.elastic_locked_rad_s))
         }));
-        panels.push(panel(format!("lumped, z = {z:.2} m"), &|ix, iy| {
+        panels.push(grid.panel(format!("lumped, z = {z:.2} m"), &|ix, iy| {
             mode_at(ix, iy, l).and_then(|q| q.lumped_locked_rad_s.map(hz))
         }));
-        panels.push(panel(format!("lowest string, z = {z:.2} m"), &|ix, iy| {
-            mode_at(ix, iy, l).and_then(|q| q.lowest_string_rad_s.map(hz))
-        }));
+        panels.push(
+            grid.panel(format!("lowest string, z = {z:.2} m"), &|ix, iy| {
+                mode_at(ix, iy, l).and_then(|q| q.lowest_string_rad_s.map(hz))
+            }),
+        );
     }
     let map = HeatMap {
         title: format!(
@@ -280,17 +321,22 @@ fn draw_maps(p: &Printer, modes: &ModeMap, flex: &FlexError, out: &Path) -> Resu
         cols: 3,
         panels,
     };
-    render_drawing(&map, &format!("spatial_{}_modes", p.key), out)?;
+    render_drawing(&map, &format!("spatial_{}_modes", p.key), out)
+}
+
+/// Static flex compensation's error on the sagging lines per layer (DIR/spatial_KEY_flex).
+fn draw_flex_maps(grid: &MapGrid, layers: &[usize; 3], flex: &FlexError, out: &Path) -> Result<()> {
+    let p = grid.p;
     let flex_at = |ix: usize, iy: usize, l: usize| {
         flex.points
             .iter()
-            .find(|q| index(q.target) == [ix, iy, l])
+            .find(|q| grid.index(q.target) == [ix, iy, l])
             .map(|q| q.error)
     };
     let panels = layers
         .iter()
         .map(|&l| {
-            panel(format!("z = {:.2} m", coord(2, l)), &|ix, iy| {
+            grid.panel(format!("z = {:.2} m", grid.coord(2, l)), &|ix, iy| {
                 flex_at(ix, iy, l)
             })
         })

@@ -9,7 +9,32 @@ use anyhow::{Result, bail};
 use cdpr_bench::core::model::{CableModel, SplitRule};
 use cdpr_bench::core::scenario::Scenario;
 use cdpr_bench::{ModelKind, ModelVisitor};
-use std::path::Path;
+use std::path::PathBuf;
+
+/// The command's options.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Scenario file (TOML, MODELS.md §9); absent = the paper's scenario.
+    #[arg(long)]
+    pub scenario: Option<PathBuf>,
+    /// Cable model, overriding the scenario's [model] kind.
+    #[arg(long, value_enum)]
+    pub model: Option<ModelKind>,
+    /// Effector x range [m] and its number of points.
+    #[arg(long, default_value_t = 0.15)]
+    pub x_min: f64,
+    #[arg(long, default_value_t = 0.85)]
+    pub x_max: f64,
+    #[arg(long, default_value_t = 2000)]
+    pub x_steps: usize,
+    /// Tension sum ΣT range [N] and its number of points.
+    #[arg(long, default_value_t = 120.0)]
+    pub tension_min: f64,
+    #[arg(long, default_value_t = 400.0)]
+    pub tension_max: f64,
+    #[arg(long, default_value_t = 250)]
+    pub tension_steps: usize,
+}
 
 /// An interval [min, max] sampled at the midpoints of `steps` equal cells.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -97,13 +122,18 @@ pub fn sweep(
     Ok((failures, x.steps * tension_sum.steps))
 }
 
-pub fn run(
-    scenario: Option<&Path>,
-    model: Option<ModelKind>,
-    x: Axis,
-    tension_sum: Axis,
-) -> Result<()> {
-    let scenario = load_scenario(scenario, model)?;
+pub fn run(args: &Args) -> Result<()> {
+    let x = Axis {
+        min: args.x_min,
+        max: args.x_max,
+        steps: args.x_steps,
+    };
+    let tension_sum = Axis {
+        min: args.tension_min,
+        max: args.tension_max,
+        steps: args.tension_steps,
+    };
+    let scenario = load_scenario(args.scenario.as_deref(), args.model)?;
     x.check("x", 0.0, scenario.robot.anchor_distance)?;
     tension_sum.check("tension", 0.0, f64::INFINITY)?;
     let kind = model_kind(&scenario)?.name();

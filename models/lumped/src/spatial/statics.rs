@@ -409,37 +409,9 @@ fn settle_with_length(
     let weight = model.node_mass / model.segment * model.robot().gravity * free;
     // Up from the straight line's tension (or the line's weight) until the line needs less
     // than `free`; a tension too low to hang the line at all needs more.
-    let mut hi = (ea * (chord / free - 1.0)).max(weight).max(1e-6);
-    let mut f_hi = f64::INFINITY;
-    let mut last = None;
-    for _ in 0..200 {
-        if let Ok((f, h)) = excess(hi) {
-            (f_hi, last) = (f, Some(h));
-            if f < 0.0 {
-                break;
-            }
-        }
-        hi *= 2.0;
-    }
-    // Down from hi until the line needs more than `free`; where it cannot hang at all, halve
-    // the gap to the last tension that could.
-    let (mut lo, mut f_lo, mut floor) = (hi, f_hi, 0.0);
-    for _ in 0..400 {
-        if f_lo > 0.0 {
-            break;
-        }
-        let t = if floor > 0.0 {
-            0.5 * (floor + lo)
-        } else {
-            0.5 * lo
-        };
-        match excess(t) {
-            Ok((f, h)) if f > 0.0 => (lo, f_lo, last) = (t, f, Some(h)),
-            Ok((f, _)) => (hi, f_hi, lo, f_lo) = (t, f, t, f),
-            Err(_) => floor = t,
-        }
-    }
-    if !(f_lo > 0.0 && f_hi < 0.0) {
+    let mut bracket = Bracket::up(&excess, (ea * (chord / free - 1.0)).max(weight).max(1e-6));
+    bracket.down(&excess);
+    if !(bracket.f_lo > 0.0 && bracket.f_hi < 0.0) {
         return Err(ModelError::State {
             t: 0.0,
             why: format!(
@@ -449,35 +421,97 @@ fn settle_with_length(
             ),
         });
     }
-    let mut side = 0;
-    for _ in 0..200 {
-        let t = hi - f_hi * (hi - lo) / (f_hi - f_lo);
-        let (f, h) = excess(t)?;
-        if f.abs() <= 1e-12 || hi - lo <= 1e-14 * hi {
-            return Ok(h);
+    bracket.illinois(&excess, cable)
+}
+
+/// A locked line's excess length (needed − held) [m] at a reel tension [N], and the line there.
+type Excess<'a> = dyn Fn(f64) -> Result<(f64, Settled), ModelError> + 'a;
+
+/// Reel tensions around a locked line's root: at `lo` it needs more than it holds, at `hi` less.
+struct Bracket {
+    lo: f64,
+    f_lo: f64,
+    hi: f64,
+    f_hi: f64,
+    /// The last line that hung (the answer if the secant does not converge).
+    last: Option<Settled>,
+}
+
+impl Bracket {
+    /// Doubles the tension from `hi` until the line needs less than it holds (or 200 doublings).
+    fn up(excess: &Excess, mut hi: f64) -> Self {
+        let mut f_hi = f64::INFINITY;
+        let mut last = None;
+        for _ in 0..200 {
+            if let Ok((f, h)) = excess(hi) {
+                (f_hi, last) = (f, Some(h));
+                if f < 0.0 {
+                    break;
+                }
+            }
+            hi *= 2.0;
         }
-        last = Some(h);
-        if f > 0.0 {
-            (lo, f_lo) = (t, f);
-            if side == 1 {
-                f_hi *= 0.5;
-            }
-            side = 1;
-        } else {
-            (hi, f_hi) = (t, f);
-            if side == -1 {
-                f_lo *= 0.5;
-            }
-            side = -1;
+        Self {
+            lo: hi,
+            f_lo: f_hi,
+            hi,
+            f_hi,
+            last,
         }
     }
-    last.ok_or_else(|| ModelError::State {
-        t: 0.0,
-        why: format!(
-            "cable {}: the locked length's tension did not converge",
-            cable + 1
-        ),
-    })
+
+    /// Halves the tension until the line needs more than it holds, or halves a can't-hang gap.
+    fn down(&mut self, excess: &Excess) {
+        let mut floor = 0.0;
+        for _ in 0..400 {
+            if self.f_lo > 0.0 {
+                break;
+            }
+            let t = if floor > 0.0 {
+                0.5 * (floor + self.lo)
+            } else {
+                0.5 * self.lo
+            };
+            match excess(t) {
+                Ok((f, h)) if f > 0.0 => (self.lo, self.f_lo, self.last) = (t, f, Some(h)),
+                Ok((f, _)) => (self.hi, self.f_hi, self.lo, self.f_lo) = (t, f, t, f),
+                Err(_) => floor = t,
+            }
+        }
+    }
+
+    /// The tension that hangs exactly the held length, to 1e-12 m, by the Illinois secant.
+    fn illinois(mut self, excess: &Excess, cable: usize) -> Result<Settled, ModelError> {
+        let mut side = 0;
+        for _ in 0..200 {
+            let t = self.hi - self.f_hi * (self.hi - self.lo) / (self.f_hi - self.f_lo);
+            let (f, h) = excess(t)?;
+            if f.abs() <= 1e-12 || self.hi - self.lo <= 1e-14 * self.hi {
+                return Ok(h);
+            }
+            self.last = Some(h);
+            if f > 0.0 {
+                (self.lo, self.f_lo) = (t, f);
+                if side == 1 {
+                    self.f_hi *= 0.5;
+                }
+                side = 1;
+            } else {
+                (self.hi, self.f_hi) = (t, f);
+                if side == -1 {
+                    self.f_lo *= 0.5;
+                }
+                side = -1;
+            }
+        }
+        self.last.ok_or_else(|| ModelError::State {
+            t: 0.0,
+            why: format!(
+                "cable {}: the locked length's tension did not converge",
+                cable + 1
+            ),
+        })
+    }
 }
 
 /// The robot at rest with every reel locked at the unstrained free lengths `lengths` [m]: the
