@@ -115,6 +115,9 @@ pub struct Dopri5 {
     cont: [Vec<f64>; 5],
     stats: SolverStats,
     started: bool,
+    /// Whether the system's last right-hand side was at (t, y) (see
+    /// [`Stepper::last_rhs_at_state`]).
+    last_rhs_at_state: bool,
 }
 
 impl Dopri5 {
@@ -140,6 +143,7 @@ impl Dopri5 {
             cont: [v(), v(), v(), v(), v()],
             stats: SolverStats::default(),
             started: false,
+            last_rhs_at_state: false,
         }
     }
 
@@ -203,6 +207,8 @@ impl Dopri5 {
         self.stats.rhs_evals += 2;
         self.h_accepted = self.h;
         self.started = true;
+        // HINIT's probe was the last evaluation, away from y0.
+        self.last_rhs_at_state = self.opts.initial_step.is_some();
         Ok(())
     }
 
@@ -217,6 +223,7 @@ impl Dopri5 {
         self.stats.restarts += 1;
         self.h = self.h_accepted;
         self.t_old = self.t;
+        self.last_rhs_at_state = true;
     }
 
     /// Hairer's HINIT: h such that h⁵·max(‖f0‖, ‖f'‖) = 0.01, from one explicit Euler probe.
@@ -325,6 +332,9 @@ impl Dopri5 {
                     h_new = h_new.abs().min(self.h.abs());
                 }
                 self.h = h_new;
+                // The FSAL stage k7 = f(t + h, y1) was the last evaluation; y1 is now y (t is
+                // t + h as the stage computed it, or t_end on the last step).
+                self.last_rhs_at_state = true;
                 return Ok(());
             }
             h_new = self.h / facc1.min(fac11 / safe);
@@ -482,5 +492,8 @@ impl<S: OdeSystem> Stepper<S> for Dopri5 {
     }
     fn stats(&self) -> SolverStats {
         Dopri5::stats(self)
+    }
+    fn last_rhs_at_state(&self) -> bool {
+        self.last_rhs_at_state
     }
 }

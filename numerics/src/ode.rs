@@ -113,6 +113,13 @@ pub trait Stepper<S: ?Sized> {
     fn dense_output(&self, t: f64, out: &mut [f64]);
     /// Counters so far.
     fn stats(&self) -> SolverStats;
+    /// Whether the system's last right-hand side was evaluated at the state of the last accepted
+    /// step (DOPRI5's first-same-as-last stage), so that what it computed there may be read
+    /// back instead of computed again. The time may still differ by an ulp (the last step ends
+    /// exactly at t_end): a reader compares it.
+    fn last_rhs_at_state(&self) -> bool {
+        false
+    }
 }
 
 /// Why an integration stopped.

@@ -19,7 +19,7 @@ pub use spatial::Path;
 use crate::controller::{self, AnyController, Controller, Reference, TensionLimits};
 use crate::model::CableModel;
 use crate::robot::distribution::BOX_TOLERANCE;
-use crate::robot::{Effector, PerCable, Robot, Tensions, Vector};
+use crate::robot::{Effector, PerCable, Robot, StructureMatrix, Tensions, Vector};
 use crate::scenario::{ControllerKind, Scenario};
 use crate::shaper::Impulses;
 use crate::trajectory::Step5;
@@ -86,6 +86,15 @@ pub struct ClosedLoop<M: CableModel<D>, const D: usize> {
     /// Whether the reels follow the controller's unstrained lengths in the model itself (the
     /// `length` controller on massive cables): see [`ClosedLoop::drives_reels_by_length`].
     length_drive: bool,
+    /// The last right-hand side's time and commanded tensions.
+    last_rhs: LastRhs,
+}
+
+/// When the last right-hand side was evaluated and what it commanded then.
+#[derive(Default)]
+struct LastRhs {
+    t: f64,
+    tensions: Tensions,
 }
 
 /// Central-difference half-step in time [s] for the commanded lengths' rate and acceleration:
@@ -135,6 +144,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
             step_start: implicit::StepStart::default(),
             residual_scratch: Default::default(),
             length_drive,
+            last_rhs: LastRhs::default(),
         })
     }
 
@@ -248,7 +258,22 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         let n = self.model_len();
         let effector = self.model.effector(&y[..n]);
         let states = &y[n..n + self.controller_len()];
-        self.command_with(t, &self.reference(t), &effector, states)
+        self.command_with(t, &self.reference(t), &effector, states, None)
+    }
+
+    /// The commanded tensions at the end (t, y) of an accepted step: those the last
+    /// right-hand side commanded when `evaluated_there` (the stepper's
+    /// [`Stepper::last_rhs_at_state`](cdpr_numerics::Stepper::last_rhs_at_state)) and it was at
+    /// this t, so that the runner's slack check after each DOPRI5 step commands nothing again;
+    /// else commanded anew. The same bits either way: the right-hand side commands through
+    /// [`ClosedLoop::command`]'s arithmetic.
+    pub fn tensions_at_step_end(&self, t: f64, y: &[f64], evaluated_there: bool) -> Tensions {
+        let last = &self.last_rhs;
+        if evaluated_there && last.t == t {
+            last.tensions
+        } else {
+            self.command(t, y).tensions
+        }
     }
 
     /// Whether a cable may carry zero tension without failing the run: reels driven by length,
@@ -267,8 +292,14 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         reference: &Reference<D>,
         effector: &Effector<D>,
         states: &[f64],
+        structure: Option<&StructureMatrix<D>>,
     ) -> Command {
-        let out = self.controller.output(reference, effector, states);
+        let out = match structure {
+            Some(w) => self
+                .controller
+                .output_with_structure(reference, effector, states, w),
+            None => self.controller.output(reference, effector, states),
+        };
         let (tensions, mut saturated) = match &self.actuation {
             Actuation::Controller => self.limits.clamp(&out.tensions),
             Actuation::Prescribed(f) => (f(t), false),
@@ -330,15 +361,27 @@ impl<M: CableModel<D>, const D: usize> OdeSystem for ClosedLoop<M, D> {
         let effector = self.model.effector(&y[..n]);
         let reference = self.reference(t);
         let states = &y[n..n + self.controller_len()];
-        let cmd = self.command_with(t, &reference, &effector, states);
+        // W formed once where both the controller and the model use it.
+        let structure = (self.controller.uses_structure_matrix()
+            && self.model.pulls_along_structure_matrix())
+        .then(|| self.robot().structure_matrix(&effector.position));
+        let cmd = self.command_with(t, &reference, &effector, states, structure.as_ref());
         if self.drives_reels_by_length() {
             self.drive_reels(t);
         }
         let (model_rate, tail) = dy.split_at_mut(n);
-        let reel = self
-            .model
-            .rhs_and_reel_speeds(t, &y[..n], &cmd.tensions, model_rate);
+        let reel = self.model.rhs_and_reel_speeds(
+            t,
+            &y[..n],
+            &cmd.tensions,
+            structure.as_ref(),
+            model_rate,
+        );
         let audits = self.audit_rates(&y[..n], &cmd.tensions, &reel);
         self.controller_and_audit_rates(y, (&reference, &effector), cmd.saturated, audits, tail);
+        self.last_rhs = LastRhs {
+            t,
+            tensions: cmd.tensions,
+        };
     }
 }

@@ -3,8 +3,8 @@
 //! structure matrix that maps tensions to the force for any desired force is the robot's:
 //! [`crate::robot::Robot::structure_matrix`].)
 
-use crate::robot::distribution::{DistributionMethod, TensionBox, distribute};
-use crate::robot::{Robot, Tensions, Vector, vertical};
+use crate::robot::distribution::{DistributionMethod, TensionBox, distribute_tensions};
+use crate::robot::{Robot, StructureMatrix, Tensions, Vector, vertical};
 use crate::scenario;
 
 /// The closed-form split of two opposed cables' tensions (paper §3.2, MODELS.md §2): the
@@ -132,16 +132,22 @@ impl TensionSolver {
         p: &Vector<D>,
         force: &Vector<D>,
     ) -> Tensions {
-        // As many cables as axes: W T = f directly (W formed there, once).
-        if robot.cables() == D
-            && let Some(t) = robot.tensions_for_force(p, force)
-        {
+        self.for_force_with(&robot.structure_matrix(p), force)
+    }
+
+    /// [`TensionSolver::for_force`] with W at the effector already formed: W T = f directly
+    /// where there are as many cables as axes, the distribution otherwise.
+    #[inline]
+    pub fn for_force_with<const D: usize>(
+        &self,
+        w: &StructureMatrix<D>,
+        force: &Vector<D>,
+    ) -> Tensions {
+        if let Some(t) = w.tensions_for_force(force) {
             return t;
         }
-        distribute(self.method, &robot.structure_matrix(p), force, self.limits).map_or_else(
-            |_| Tensions::from_fn(robot.cables(), |_| f64::NAN),
-            |d| d.tensions,
-        )
+        distribute_tensions(self.method, w, force, self.limits)
+            .unwrap_or_else(|_| Tensions::from_fn(w.columns().len(), |_| f64::NAN))
     }
 
     /// Tensions that give the effector at `p` the acceleration `a` [m/s²] on rigid massless
@@ -153,9 +159,20 @@ impl TensionSolver {
         p: &Vector<D>,
         a: &Vector<D>,
     ) -> Tensions {
+        self.for_acceleration_with(robot, &robot.structure_matrix(p), a)
+    }
+
+    /// [`TensionSolver::for_acceleration`] with W at the effector already formed.
+    #[inline]
+    pub fn for_acceleration_with<const D: usize>(
+        &self,
+        robot: &Robot<D>,
+        w: &StructureMatrix<D>,
+        a: &Vector<D>,
+    ) -> Tensions {
         let v = vertical::<D>();
         let mut lift = *a;
         lift[v] = a[v] + robot.gravity;
-        self.for_force(robot, p, &(lift * robot.effector_mass))
+        self.for_force_with(w, &(lift * robot.effector_mass))
     }
 }

@@ -35,13 +35,16 @@ impl PerCable {
         v
     }
 
-    /// `f(i)` for cables i = 0 … m − 1.
+    /// `f(i)` for cables i = 0 … m − 1, in that order.
     pub fn from_fn(m: usize, mut f: impl FnMut(usize) -> f64) -> Self {
-        let mut v = Self::zeros(m);
-        for (i, x) in v.iter_mut().enumerate() {
-            *x = f(i);
+        assert!(m <= MAX_CABLES, "{m} cables: at most {MAX_CABLES}");
+        // As one array expression, not element stores into zeros: a short closure then fills
+        // vector registers, and the copy that follows does not wait on narrow stores (a
+        // store-forwarding stall was a fifth of the one-redundancy QP).
+        Self {
+            values: std::array::from_fn(|i| if i < m { f(i) } else { 0.0 }),
+            len: m,
         }
-        v
     }
 
     /// The values of the two cables of a planar robot.

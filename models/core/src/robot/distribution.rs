@@ -17,6 +17,7 @@
 use super::StructureMatrix;
 use super::cables::{CableId, MAX_CABLES, Tensions};
 use super::gram::gram_inverse;
+use super::line_qp::qp_on_the_line;
 use super::space::{Matrix, Vector};
 
 /// A tension distribution method (`[controller] distribution`).
@@ -131,7 +132,7 @@ impl TensionBox {
     }
 
     /// How far `t` lies outside the box [N] (≤ 0 inside).
-    fn violation(&self, t: f64) -> f64 {
+    pub(super) fn violation(&self, t: f64) -> f64 {
         (self.t_min - t).max(t - self.t_max)
     }
 }
@@ -193,6 +194,21 @@ pub fn distribute<const D: usize>(
     }
 }
 
+/// The tensions of [`distribute`] alone, for a controller's right-hand side: the QP of one
+/// degree of redundancy (Hangprinter) skips the bookkeeping of which cables it clamped.
+pub fn distribute_tensions<const D: usize>(
+    method: DistributionMethod,
+    w: &StructureMatrix<D>,
+    wrench: &Vector<D>,
+    limits: TensionBox,
+) -> Result<Tensions, DistributionError> {
+    if method == DistributionMethod::Qp && w.columns().len() == D + 1 {
+        check(wrench, limits)?;
+        return qp_on_the_line(w, wrench, limits).map(|p| p.tensions);
+    }
+    distribute(method, w, wrench, limits).map(|d| d.tensions)
+}
+
 fn check<const D: usize>(wrench: &Vector<D>, limits: TensionBox) -> Result<(), DistributionError> {
     if !wrench.iter().all(|v| v.is_finite()) {
         return Err(DistributionError::NotFinite {
@@ -208,7 +224,7 @@ fn check<const D: usize>(wrench: &Vector<D>, limits: TensionBox) -> Result<(), D
     Ok(())
 }
 
-fn inside(t: &Tensions, limits: TensionBox) -> bool {
+pub(super) fn inside(t: &Tensions, limits: TensionBox) -> bool {
     t.iter().all(|&v| limits.violation(v) <= BOX_TOLERANCE)
 }
 
@@ -362,17 +378,17 @@ fn puncture<const D: usize>(
 /// T(λ) = clamp(Wᵀλ), so a λ with W T(λ) = w makes T(λ) the optimum (KKT hold by construction).
 /// Newton on ∇q = w − W T(λ) with the free cables' Gram matrix and a backtracking line search;
 /// if it does not settle (an infeasible problem's dual is unbounded), every active set is tried.
-/// One degree of redundancy has its exact closed form ([`qp_on_the_line`]).
+/// One degree of redundancy has its exact closed form (`line_qp`).
 fn qp<const D: usize>(
     w: &StructureMatrix<D>,
     wrench: &Vector<D>,
     limits: TensionBox,
 ) -> Result<Distribution, DistributionError> {
     let m = w.columns().len();
-    let g_inv = full_gram_inverse(w)?;
     if m == D + 1 {
-        return Ok(qp_on_the_line(w, wrench, &g_inv, limits));
+        return qp_on_the_line(w, wrench, limits).map(Distribution::from);
     }
+    let g_inv = full_gram_inverse(w)?;
     let scale = wrench.norm() + limits.t_max.abs().max(limits.t_min.abs());
     let tol = 1e-13 * scale;
     let clamp = |z: f64| z.clamp(limits.t_min, limits.t_max);
@@ -414,82 +430,6 @@ fn qp<const D: usize>(
         lambda += step * alpha;
     }
     Ok(qp_by_enumeration(w, wrench, limits, tol))
-}
-
-/// The QP with one degree of redundancy (m = D + 1, Hangprinter), exactly and without
-/// iterating: the solutions of W T = w are the line T(s) = W⁺w + s n, n the unit null vector of
-/// W, and W⁺w ⟂ n, so ‖T(s)‖² = ‖W⁺w‖² + s² is least at the s of the box's interval
-/// [s_lo, s_hi] nearest 0. An empty interval: no distribution; W⁺w is returned, infeasible.
-fn qp_on_the_line<const D: usize>(
-    w: &StructureMatrix<D>,
-    wrench: &Vector<D>,
-    g_inv: &Matrix<D>,
-    limits: TensionBox,
-) -> Distribution {
-    let m = w.columns().len();
-    let lambda = g_inv * wrench;
-    let minimum_norm = Tensions::from_fn(m, |i| w.column(i).dot(&lambda));
-    // n = (I − W⁺W) e_k for the k with the largest diagonal 1 − u_kᵀ G⁻¹ u_k (the best-
-    // conditioned column of the projector), normalised.
-    let k = (0..m)
-        .map(|i| (i, 1.0 - w.column(i).dot(&(g_inv * w.column(i)))))
-        .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a })
-        .0;
-    let pull = g_inv * w.column(k);
-    let mut null = Tensions::from_fn(m, |i| f64::from(u8::from(i == k)) - w.column(i).dot(&pull));
-    let norm = null.iter().map(|v| v * v).sum::<f64>().sqrt();
-    null.iter_mut().for_each(|v| *v /= norm);
-    // Each cable's bounds on s; the cable that sets each end of the interval.
-    let (mut lo, mut hi) = ((f64::NEG_INFINITY, None), (f64::INFINITY, None));
-    for i in 0..m {
-        let (t, n) = (minimum_norm[i], null[i]);
-        if n.abs() < 1e-14 {
-            if limits.violation(t) > BOX_TOLERANCE {
-                (lo, hi) = ((f64::INFINITY, None), (f64::NEG_INFINITY, None));
-                break;
-            }
-            continue;
-        }
-        let (a, b) = ((limits.t_min - t) / n, (limits.t_max - t) / n);
-        let (from, to, bound_from, bound_to) = if n > 0.0 {
-            (a, b, Bound::Min, Bound::Max)
-        } else {
-            (b, a, Bound::Max, Bound::Min)
-        };
-        if from > lo.0 {
-            lo = (from, Some((CableId(i), bound_from)));
-        }
-        if to < hi.0 {
-            hi = (to, Some((CableId(i), bound_to)));
-        }
-    }
-    if lo.0 > hi.0 {
-        return Distribution {
-            feasible: inside(&minimum_norm, limits),
-            tensions: minimum_norm,
-            clamped: Clamped::new(),
-        };
-    }
-    let s = 0.0f64.clamp(lo.0, hi.0);
-    let mut tensions = Tensions::from_fn(m, |i| minimum_norm[i] + s * null[i]);
-    let clamped: Clamped = match (s == lo.0, s == hi.0) {
-        (true, _) => lo.1.into_iter().collect(),
-        (_, true) => hi.1.into_iter().collect(),
-        _ => Clamped::new(),
-    };
-    // The cable that sets s sits exactly on its bound (not an ulp past it, which a clamp
-    // downstream would count as saturation).
-    for &(cable, bound) in clamped.iter() {
-        tensions[cable.index()] = match bound {
-            Bound::Min => limits.t_min,
-            Bound::Max => limits.t_max,
-        };
-    }
-    Distribution {
-        feasible: inside(&tensions, limits),
-        tensions,
-        clamped,
-    }
 }
 
 fn qp_result<const D: usize>(

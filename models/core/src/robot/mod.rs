@@ -25,6 +25,7 @@
 pub mod cables;
 pub mod distribution;
 mod gram;
+mod line_qp;
 pub mod reels;
 pub mod space;
 
@@ -121,6 +122,23 @@ impl<const D: usize> StructureMatrix<D> {
     pub fn square(&self) -> Option<Matrix<D>> {
         (self.cables == D).then(|| Matrix::from_fn(|r, c| self.columns[c][r]))
     }
+
+    /// T = W⁻¹ f [N] for a robot with as many cables as axes (None for others), as
+    /// [`Robot::tensions_for_force`] with W already formed.
+    pub fn tensions_for_force(&self, force: &Vector<D>) -> Option<Tensions> {
+        let w = self.square()?;
+        if D == 2 {
+            let det = w[(0, 0)] * w[(1, 1)] - w[(0, 1)] * w[(1, 0)];
+            return Some(Tensions::pair([
+                (w[(1, 1)] * force[0] - w[(0, 1)] * force[1]) / det,
+                (w[(0, 0)] * force[1] - w[(1, 0)] * force[0]) / det,
+            ]));
+        }
+        let t = w
+            .try_inverse()
+            .map_or_else(|| Vector::from_element(f64::NAN), |inv| inv * force);
+        Some(Tensions::from_slice(t.as_slice()))
+    }
 }
 
 impl<const D: usize> Robot<D> {
@@ -197,7 +215,7 @@ impl<const D: usize> Robot<D> {
     pub fn structure_matrix(&self, p: &Vector<D>) -> StructureMatrix<D> {
         let mut columns = [Vector::zeros(); MAX_CABLES];
         for (i, column) in columns.iter_mut().enumerate().take(self.cables) {
-            *column = (self.anchors[i] - p).normalize();
+            *column = unit(self.anchors[i] - p);
         }
         StructureMatrix {
             columns,
@@ -211,18 +229,7 @@ impl<const D: usize> Robot<D> {
     /// degenerate pose non-finite tensions come back, which the runner refuses as it refuses
     /// slack.
     pub fn tensions_for_force(&self, p: &Vector<D>, force: &Vector<D>) -> Option<Tensions> {
-        let w = self.structure_matrix(p).square()?;
-        if D == 2 {
-            let det = w[(0, 0)] * w[(1, 1)] - w[(0, 1)] * w[(1, 0)];
-            return Some(Tensions::pair([
-                (w[(1, 1)] * force[0] - w[(0, 1)] * force[1]) / det,
-                (w[(0, 0)] * force[1] - w[(1, 0)] * force[0]) / det,
-            ]));
-        }
-        let t = w
-            .try_inverse()
-            .map_or_else(|| Vector::from_element(f64::NAN), |inv| inv * force);
-        Some(Tensions::from_slice(t.as_slice()))
+        self.structure_matrix(p).tensions_for_force(force)
     }
 
     /// The geometric stiffness G = ∂(W T)/∂p = −Σ T_i (I − u_i u_iᵀ)/l_i [N/m] at fixed
@@ -265,6 +272,18 @@ impl<const D: usize> Robot<D> {
             }
             _ => inside_hull(self.anchors().iter().map(|a| [a[0], a[1]]), [p[0], p[1]]),
         }
+    }
+}
+
+/// v/|v|. The plane divides each component by the length (the paper's bits); space multiplies
+/// by the length's reciprocal, a third of the divisions (divisions and square roots bound a
+/// spatial right-hand side).
+#[inline]
+fn unit<const D: usize>(v: Vector<D>) -> Vector<D> {
+    if D == 2 {
+        v / v.norm()
+    } else {
+        v * (1.0 / v.norm())
     }
 }
 

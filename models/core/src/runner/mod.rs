@@ -402,7 +402,7 @@ fn integrate<M: CableModel<D>, const D: usize>(
             clock.take_through(sys, stepper, t, &mut observer.frames);
             check_slack(
                 t,
-                &sys.command(t, stepper.state()).tensions,
+                &sys.tensions_at_step_end(t, stepper.state(), stepper.last_rhs_at_state()),
                 sys.slack_allowed(),
             )?;
             monitor.accept(sys, stepper.state());
