@@ -8,7 +8,7 @@
 //! the highest acceleration whose contour error over the printing moves (travel excluded: a
 //! travel's error draws nothing) stays within [`GOOD_CONTOUR`].
 
-use crate::spatial_modes::{SpatialLoop, SpatialModes, at_pose};
+use crate::spatial_modes::{SpatialLoop, SpatialMode, SpatialModes, at_pose};
 use crate::{Result, pool};
 use cdpr_bench::ModelKind;
 use cdpr_bench::core::runner::Observer;
@@ -116,28 +116,68 @@ pub struct PrintStudy {
 }
 
 /// Per axis x, y, z: the frequency [Hz] of the loop's least-damped oscillatory mode whose
-/// motion is mostly along that axis (|direction_k| ≥ 1/2), from the closed-loop modes; where
-/// no mode is (a controller with equal gains on every axis has repeated modes, whose
-/// directions are any in their span), the least-damped oscillatory mode.
+/// motion can lie mostly along that axis, from the closed-loop modes; where no mode does, the
+/// least-damped oscillatory mode.
+///
+/// A mode lies along axis k when a unit motion in its eigenspace has a k component of at least
+/// 1/2. For a simple mode that is |direction_k| ≥ 1/2; a repeated eigenvalue (a controller with
+/// equal gains on every axis has three) has directions that are any basis of its eigenspace,
+/// so there it is the length of e_k's projection onto their span — a choice the eigen-solver's
+/// round-off cannot change.
 pub fn auto_frequencies(modes: &SpatialModes) -> [Option<f64>; 3] {
-    let mut best: [Option<(f64, f64)>; 3] = [None; 3];
-    let mut any: Option<(f64, f64)> = None;
-    for m in modes
+    let closed: Vec<&SpatialMode> = modes
         .modes
         .iter()
         .filter(|m| m.linearisation == SpatialLoop::Closed && m.omega_rad_s > 0.0)
-    {
+        .collect();
+    let mut best: [Option<(f64, f64)>; 3] = [None; 3];
+    let mut any: Option<(f64, f64)> = None;
+    for m in &closed {
         let zeta = -m.growth / m.growth.hypot(m.omega_rad_s);
+        let hz = m.omega_rad_s / (2.0 * std::f64::consts::PI);
         if any.is_none_or(|(z, _)| zeta < z) {
-            any = Some((zeta, m.omega_rad_s / (2.0 * std::f64::consts::PI)));
+            any = Some((zeta, hz));
         }
-        for (slot, along) in best.iter_mut().zip(m.direction) {
-            if along.abs() >= 0.5 && slot.is_none_or(|(z, _)| zeta < z) {
-                *slot = Some((zeta, m.omega_rad_s / (2.0 * std::f64::consts::PI)));
+        let span = orthonormal(
+            closed
+                .iter()
+                .filter(|o| same_eigenvalue(o, m))
+                .map(|o| o.direction),
+        );
+        for (k, slot) in best.iter_mut().enumerate() {
+            let along = span.iter().map(|q| q[k] * q[k]).sum::<f64>().sqrt();
+            if along >= 0.5 && slot.is_none_or(|(z, _)| zeta < z) {
+                *slot = Some((zeta, hz));
             }
         }
     }
     best.map(|b| b.or(any).map(|(_, hz)| hz))
+}
+
+/// Whether two modes share their eigenvalue λ = σ + iω: to 1e-6 of |λ|, far above a dense
+/// eigen-solver's spread within a repeated eigenvalue (~1e-12 relative) and far below the gap
+/// between distinct modes of a loop (percent).
+fn same_eigenvalue(a: &SpatialMode, b: &SpatialMode) -> bool {
+    let scale = 1e-6 * a.omega_rad_s.hypot(a.growth);
+    (a.omega_rad_s - b.omega_rad_s).abs() <= scale && (a.growth - b.growth).abs() <= scale
+}
+
+/// An orthonormal basis of the span of `directions` (Gram–Schmidt; a direction within 1e-6 of
+/// the span so far, or a zero one of the controller's states alone, adds nothing).
+fn orthonormal(directions: impl Iterator<Item = [f64; 3]>) -> Vec<[f64; 3]> {
+    let mut basis: Vec<[f64; 3]> = Vec::new();
+    for d in directions {
+        let mut v = d;
+        for q in &basis {
+            let along = (0..3).map(|k| v[k] * q[k]).sum::<f64>();
+            (0..3).for_each(|k| v[k] -= along * q[k]);
+        }
+        let norm = (0..3).map(|k| v[k] * v[k]).sum::<f64>().sqrt();
+        if norm > 1e-6 {
+            basis.push(v.map(|c| c / norm));
+        }
+    }
+    basis
 }
 
 /// Whether the scenario shapes an axis at an `"auto"` frequency.
