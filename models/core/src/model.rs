@@ -340,10 +340,9 @@ pub trait CableModel<const D: usize> {
         t: f64,
         state: &[f64],
         tensions: &[f64],
-        structure: Option<&StructureMatrix<D>>,
+        _structure: Option<&StructureMatrix<D>>,
         rate: &mut [f64],
     ) -> PerCable {
-        let _ = structure;
         self.rhs(t, state, tensions, rate);
         self.reel_speeds(state)
     }

@@ -135,43 +135,30 @@ fn nearest_on_the_line(minimum_norm: &Tensions, null: &Tensions, limits: Tension
         };
     }
     let s = 0.0f64.clamp(lo, hi);
-    // The first cable that sets the end s lies on. T_i grows with s where n_i > 0: the
-    // interval's lower end is then cable i's t_min, its upper end its t_max; the other way
-    // round where n_i < 0.
-    let on_bound = if s == lo && lo > f64::NEG_INFINITY {
-        (0..m).find(|&i| ends(i).0 == lo).map(|i| {
-            let bound = if null[i] > 0.0 {
-                Bound::Min
-            } else {
-                Bound::Max
-            };
-            (CableId(i), bound)
-        })
+    // The first cable that sets the end `s` lies on (the upper end or the lower). T_i grows
+    // with s where n_i > 0: the lower end is then cable i's t_min, the upper its t_max; the
+    // other way round where n_i < 0.
+    let setting = |upper: bool| {
+        let end = if upper { hi } else { lo };
+        (0..m)
+            .find(|&i| (if upper { ends(i).1 } else { ends(i).0 }) == end)
+            .map(|i| (i, (null[i] > 0.0) == upper))
+    };
+    let on_max = if s == lo && lo > f64::NEG_INFINITY {
+        setting(false)
     } else if s == hi && hi < f64::INFINITY {
-        (0..m).find(|&i| ends(i).1 == hi).map(|i| {
-            let bound = if null[i] > 0.0 {
-                Bound::Max
-            } else {
-                Bound::Min
-            };
-            (CableId(i), bound)
-        })
+        setting(true)
     } else {
         None
     };
-    // The cable that sets s sits exactly on its bound (not an ulp past it, which a clamp
-    // downstream would count as saturation).
-    let at_bound = on_bound.map(|(cable, bound)| {
-        let value = match bound {
-            Bound::Min => limits.t_min,
-            Bound::Max => limits.t_max,
-        };
-        (cable.index(), value)
-    });
-    let tensions = Tensions::from_fn(m, |i| match at_bound {
-        Some((cable, value)) if cable == i => value,
+    // That cable sits exactly on its bound (not an ulp past it, which a clamp downstream
+    // would count as saturation).
+    let tensions = Tensions::from_fn(m, |i| match on_max {
+        Some((cable, true)) if cable == i => limits.t_max,
+        Some((cable, false)) if cable == i => limits.t_min,
         _ => minimum_norm[i] + s * null[i],
     });
+    let on_bound = on_max.map(|(i, max)| (CableId(i), if max { Bound::Max } else { Bound::Min }));
     LinePoint {
         feasible: inside(&tensions, limits),
         tensions,
