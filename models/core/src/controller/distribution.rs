@@ -81,13 +81,14 @@ impl TensionLimits {
         // Compared cable by cable as each is clamped (a NaN counts as clamped): comparing the
         // whole inline array afterwards reads it back in wide loads just after its narrow
         // stores, a store-forwarding stall that was a fifth of the planar RHS.
-        let mut clamped = *tensions;
+        // Built as one array expression, so that the command it is copied into does not wait
+        // on narrow stores either.
         let mut saturated = false;
-        for t in clamped.iter_mut() {
-            let c = t.clamp(self.t_min, self.t_max);
-            saturated |= c != *t;
-            *t = c;
-        }
+        let clamped = Tensions::from_fn(tensions.len(), |i| {
+            let c = tensions[i].clamp(self.t_min, self.t_max);
+            saturated |= c != tensions[i];
+            c
+        });
         (clamped, saturated)
     }
 

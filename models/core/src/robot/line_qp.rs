@@ -4,7 +4,7 @@
 //! square sub-system, then the point of the solution line nearest the least-norm one.
 
 use super::StructureMatrix;
-use super::cables::{CableId, Tensions};
+use super::cables::{CableId, MAX_CABLES, Tensions};
 use super::distribution::{BOX_TOLERANCE, Bound, Distribution, DistributionError};
 use super::distribution::{TensionBox, inside};
 use super::space::Vector;
@@ -42,8 +42,10 @@ pub(super) fn qp_on_the_line<const D: usize>(
     wrench: &Vector<D>,
     limits: TensionBox,
 ) -> Result<LinePoint, DistributionError> {
-    let u = w.columns();
-    let m = u.len();
+    // m = D + 1 as a constant (the callers' precondition): the loops over the cables unroll.
+    let m = D + 1;
+    debug_assert_eq!(w.columns().len(), m, "one degree of redundancy");
+    let u = &w.columns()[..m];
     let null = Tensions::from_fn(m, |i| {
         let minor = determinant(&without(u, i, None));
         if i % 2 == 0 { minor } else { -minor }
@@ -71,7 +73,7 @@ pub(super) fn qp_on_the_line<const D: usize>(
     });
     let along = cramer.dot(&null) * per_det_norm2;
     let minimum_norm = Tensions::from_fn(m, |i| cramer[i] * per_det - along * null[i]);
-    Ok(nearest_on_the_line(&minimum_norm, &null, limits))
+    Ok(nearest_on_the_line(m, &minimum_norm, &null, limits))
 }
 
 /// det [c_1 … c_D] by its closed form: the plane's 2 × 2, space's triple product
@@ -99,31 +101,45 @@ fn without<const D: usize>(
     })
 }
 
-/// The point of the line T(s) = `minimum_norm` + s `null` inside the box with the least |s|,
-/// the cable that sets s put exactly on its bound. `null` need not be a unit vector: T(s) is
-/// the same point whatever its length, and a cable whose share of it is below 1e-14 of its
-/// length does not move along the line.
-fn nearest_on_the_line(minimum_norm: &Tensions, null: &Tensions, limits: TensionBox) -> LinePoint {
-    let m = minimum_norm.len();
+/// The point of the line T(s) = `minimum_norm` + s `null` (`m` cables) inside the box with
+/// the least |s|, the cable that sets s put exactly on its bound. `null` need not be a unit
+/// vector: T(s) is the same point whatever its length, and a cable whose share of it is below
+/// 1e-14 of its length does not move along the line. Inlined, so that `m` is the caller's
+/// constant.
+#[inline]
+fn nearest_on_the_line(
+    m: usize,
+    minimum_norm: &Tensions,
+    null: &Tensions,
+    limits: TensionBox,
+) -> LinePoint {
     let level = 1e-14 * null.dot(null).sqrt();
     // Cable i keeps T_i in the box for s in [from_i, to_i] (all s where it does not move).
     // Written as selects and min/max, so the interval [lo, hi] is found without the branches
     // an integrator's changing wrenches mispredict.
-    let ends = |i: usize| {
+    let (mut from, mut to) = ([f64::NEG_INFINITY; MAX_CABLES], [f64::INFINITY; MAX_CABLES]);
+    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+    for i in 0..m {
         let (t, n) = (minimum_norm[i], null[i]);
         let per_s = 1.0 / n;
         let (a, b) = ((limits.t_min - t) * per_s, (limits.t_max - t) * per_s);
-        match (n.abs() >= level, n > 0.0) {
-            (false, _) => (f64::NEG_INFINITY, f64::INFINITY),
-            (true, true) => (a, b),
-            (true, false) => (b, a),
-        }
-    };
-    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
-    for i in 0..m {
-        let (from, to) = ends(i);
-        lo = lo.max(from);
-        hi = hi.min(to);
+        let moves = n.abs() >= level;
+        from[i] = if !moves {
+            f64::NEG_INFINITY
+        } else if n > 0.0 {
+            a
+        } else {
+            b
+        };
+        to[i] = if !moves {
+            f64::INFINITY
+        } else if n > 0.0 {
+            b
+        } else {
+            a
+        };
+        lo = lo.max(from[i]);
+        hi = hi.min(to[i]);
     }
     let still_outside =
         |i: usize| null[i].abs() < level && limits.violation(minimum_norm[i]) > BOX_TOLERANCE;
@@ -141,7 +157,7 @@ fn nearest_on_the_line(minimum_norm: &Tensions, null: &Tensions, limits: Tension
     let setting = |upper: bool| {
         let end = if upper { hi } else { lo };
         (0..m)
-            .find(|&i| (if upper { ends(i).1 } else { ends(i).0 }) == end)
+            .find(|&i| (if upper { to[i] } else { from[i] }) == end)
             .map(|i| (i, (null[i] > 0.0) == upper))
     };
     let on_max = if s == lo && lo > f64::NEG_INFINITY {
@@ -153,10 +169,17 @@ fn nearest_on_the_line(minimum_norm: &Tensions, null: &Tensions, limits: Tension
     };
     // That cable sits exactly on its bound (not an ulp past it, which a clamp downstream
     // would count as saturation).
-    let tensions = Tensions::from_fn(m, |i| match on_max {
-        Some((cable, true)) if cable == i => limits.t_max,
-        Some((cable, false)) if cable == i => limits.t_min,
-        _ => minimum_norm[i] + s * null[i],
+    let (cable, bound) = match on_max {
+        Some((cable, true)) => (cable, limits.t_max),
+        Some((cable, false)) => (cable, limits.t_min),
+        None => (usize::MAX, 0.0),
+    };
+    let tensions = Tensions::from_fn(m, |i| {
+        if i == cable {
+            bound
+        } else {
+            minimum_norm[i] + s * null[i]
+        }
     });
     let on_bound = on_max.map(|(i, max)| (CableId(i), if max { Bound::Max } else { Bound::Min }));
     LinePoint {
