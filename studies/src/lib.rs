@@ -27,6 +27,7 @@ pub mod paper;
 pub mod paper_report;
 pub mod pool;
 pub mod print_study;
+pub mod repeated_modes;
 pub mod samples;
 pub mod shaping;
 pub mod spatial_modes;

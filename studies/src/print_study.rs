@@ -9,7 +9,7 @@
 //! travel's error draws nothing) stays within [`GOOD_CONTOUR`].
 
 use crate::spatial_modes::{SpatialLoop, SpatialMode, SpatialModes, at_pose};
-use crate::{Result, pool};
+use crate::{Result, pool, repeated_modes};
 use cdpr_bench::ModelKind;
 use cdpr_bench::core::runner::Observer;
 use cdpr_bench::core::scenario::{
@@ -154,12 +154,9 @@ pub fn auto_frequencies(modes: &SpatialModes) -> [Option<f64>; 3] {
     best.map(|b| b.or(any).map(|(_, hz)| hz))
 }
 
-/// Whether two modes share their eigenvalue λ = σ + iω: to 1e-6 of |λ|, far above a dense
-/// eigen-solver's spread within a repeated eigenvalue (~1e-12 relative) and far below the gap
-/// between distinct modes of a loop (percent).
+/// Whether two modes share their eigenvalue ([`repeated_modes::same_eigenvalue`]).
 fn same_eigenvalue(a: &SpatialMode, b: &SpatialMode) -> bool {
-    let scale = 1e-6 * a.omega_rad_s.hypot(a.growth);
-    (a.omega_rad_s - b.omega_rad_s).abs() <= scale && (a.growth - b.growth).abs() <= scale
+    repeated_modes::same_eigenvalue((a.growth, a.omega_rad_s), (b.growth, b.omega_rad_s))
 }
 
 /// An orthonormal basis of the span of `directions` (Gram–Schmidt; a direction within 1e-6 of

@@ -7,6 +7,7 @@
 //! locked, each named (effector x, y, vertical; each cable's string in and across its vertical
 //! plane; axial). The tensions at rest are the scenario's distribution of the weight there.
 
+use crate::repeated_modes::{self, Complex};
 use crate::{Result, StudyError};
 use cdpr_bench::analysis::linearise::closed_loop_jacobian;
 use cdpr_bench::analysis::modes::ModeKind;
@@ -154,6 +155,11 @@ fn open_loop_modes(robot: &Robot<3>, p: &Vector<3>, tensions: &[f64], ea: f64) -
             })
             .collect();
         pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let first = modes.len();
+        let motions: Vec<[Complex; 3]> = pairs
+            .iter()
+            .map(|(_, v)| [0, 1, 2].map(|k| (v[k], 0.0)))
+            .collect();
         for (lambda, v) in pairs {
             let direction = [v[0], v[1], v[2]];
             modes.push(SpatialMode {
@@ -166,8 +172,34 @@ fn open_loop_modes(robot: &Robot<3>, p: &Vector<3>, tensions: &[f64], ea: f64) -
                 effector_share: None,
             });
         }
+        // A real eigenspace's axis basis is real: its directions keep their signs.
+        from_eigenspaces(robot, &mut modes[first..], &motions, |c| c.map(|z| z.0));
     }
     modes
+}
+
+/// The directions (and names) of modes that share an eigenvalue, replaced by their eigenspace's
+/// axis basis ([`repeated_modes`]), `direction_of` turning a unit complex motion into the
+/// reported direction; `motions` are the modes' effector parts. A simple mode keeps its own.
+fn from_eigenspaces(
+    robot: &Robot<3>,
+    modes: &mut [SpatialMode],
+    motions: &[[Complex; 3]],
+    direction_of: impl Fn(&[Complex; 3]) -> [f64; 3],
+) {
+    let eigenvalues: Vec<(f64, f64)> = modes.iter().map(|m| (m.growth, m.omega_rad_s)).collect();
+    for group in repeated_modes::groups(&eigenvalues) {
+        if group.len() < 2 {
+            continue;
+        }
+        let own: Vec<[Complex; 3]> = group.iter().map(|&i| motions[i]).collect();
+        let basis = repeated_modes::axis_basis(&own);
+        for (n, &i) in group.iter().enumerate() {
+            let direction = basis.get(n).map_or([0.0; 3], &direction_of);
+            modes[i].direction = direction;
+            modes[i].name = name(robot, direction);
+        }
+    }
 }
 
 /// Every mode of the scenario's massive `lines` at rest at `p` [m] under `tensions` [N], reels
@@ -264,7 +296,11 @@ fn closed_loop_modes(
     let jacobian = closed_loop_jacobian(sys, 0.0, y);
     let shapes = mode_shapes(&jacobian)
         .map_err(|e| StudyError::Failed(format!("closed-loop modes at {pose:?} m: {e}")))?;
-    Ok(shapes
+    let motions: Vec<[Complex; 3]> = shapes
+        .iter()
+        .map(|s| [s.vector[0], s.vector[1], s.vector[2]])
+        .collect();
+    let mut modes: Vec<SpatialMode> = shapes
         .into_iter()
         .map(|shape| {
             // The effector's position components of the (complex) eigenvector, by magnitude.
@@ -286,7 +322,10 @@ fn closed_loop_modes(
                 effector_share: None,
             }
         })
-        .collect())
+        .collect();
+    // A complex motion's direction is its components' magnitudes, as for a simple mode.
+    from_eigenspaces(robot, &mut modes, &motions, |c| c.map(|z| z.0.hypot(z.1)));
+    Ok(modes)
 }
 
 /// A mode's name from its direction's dominant axis.
