@@ -2,6 +2,7 @@
 //! pivoting factorisation, refactorised on the known pattern, and swept by the solve.
 
 use super::lanes::LaneSweeps;
+use super::rows::RowSweeps;
 use faer::perm::PermRef;
 use faer::sparse::SymbolicSparseColMatRef;
 use faer::sparse::linalg::lu::simplicial::SimplicialLu;
@@ -53,6 +54,8 @@ pub(super) struct Factors {
     /// [`LaneSweeps::worthwhile`] (a two-front order).
     pub(super) lanes: LaneSweeps,
     pub(super) in_lanes: bool,
+    /// The same factors by rows, used by the solve otherwise.
+    rows: RowSweeps,
 }
 
 impl Factors {
@@ -128,6 +131,10 @@ impl Factors {
         self.in_lanes = self.lanes.worthwhile();
         if self.in_lanes {
             self.lanes.fill(&self.l_val, &self.u_val, &self.u_inv_diag);
+        } else {
+            self.rows
+                .plan((&self.l_ptr, &self.l_row), (&self.u_ptr, &self.u_row));
+            self.rows.fill(&self.l_val, &self.u_val);
         }
         self.x.clear();
         self.x.resize(self.lanes.padded_len(), 0.0);
@@ -176,6 +183,8 @@ impl Factors {
         }
         if self.in_lanes {
             self.lanes.fill(&self.l_val, &self.u_val, &self.u_inv_diag);
+        } else {
+            self.rows.fill(&self.l_val, &self.u_val);
         }
         true
     }
@@ -199,29 +208,10 @@ impl Factors {
             self.x[n..].fill(0.0);
             self.lanes.solve(&mut self.x);
         } else {
-            self.sweep_columns();
+            let n = self.u_inv_diag.len();
+            self.rows.solve(&mut self.x[..n], &self.u_inv_diag);
         }
         let n = self.u_inv_diag.len();
         &mut self.x[..n]
-    }
-
-    /// x ← U⁻¹ L⁻¹ x by columns.
-    #[inline]
-    pub(super) fn sweep_columns(&mut self) {
-        let n = self.u_inv_diag.len();
-        let x = &mut self.x[..n];
-        for j in 0..x.len() {
-            let xj = x[j];
-            for k in self.l_ptr[j]..self.l_ptr[j + 1] {
-                x[self.l_row[k]] -= self.l_val[k] * xj;
-            }
-        }
-        for j in (0..x.len()).rev() {
-            let xj = x[j] * self.u_inv_diag[j];
-            x[j] = xj;
-            for k in self.u_ptr[j]..self.u_ptr[j + 1] {
-                x[self.u_row[k]] -= self.u_val[k] * xj;
-            }
-        }
     }
 }

@@ -24,6 +24,7 @@ mod cost;
 mod factors;
 mod lanes;
 mod layout;
+mod rows;
 
 pub use cost::SolveCost;
 use layout::Layout;
