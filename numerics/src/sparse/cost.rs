@@ -19,7 +19,8 @@ pub struct SolveCost {
 impl SolveCost {
     /// A link of a column sweep's chain (a store, its reload and a multiply-add on the critical
     /// path) costs about as much as 8 independent multiply-adds on current cores; the sweeps
-    /// take whichever of the two bounds is larger.
+    /// take whichever of the two bounds is larger. (The unpaired solve now sweeps by rows; the
+    /// price is kept, so that the layouts chosen, and the results, stay as they were.)
     pub(super) const LINK: usize = 8;
     /// A link of the paired sweeps: one multiply-add's latency. (Lumped N = 40, n = 161: 0.55
     /// µs per solve against 1.23 µs by columns, gather and scatter included.)

@@ -16,7 +16,8 @@
 //!   KLU's refactor), pivoting afresh through faer when a reused pivot falls below a tenth of its
 //!   column.
 //! - The solve sweeps the factors itself, by rows and two unknowns at a time where the two-front
-//!   order puts the entries at even distances from the diagonal (`lanes`).
+//!   order puts the entries at even distances from the diagonal (`lanes`), by rows one unknown at
+//!   a time otherwise (`rows`), in the column sweep's order of operations.
 //!
 //! `docs/numerics.md` explains each choice; `docs/performance.md` has the measurements.
 
