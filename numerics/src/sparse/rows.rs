@@ -61,7 +61,7 @@ impl Rows {
     }
 
     /// Row i's Σ-free update: `x_i` less each entry times its (final) unknown, in order.
-    #[inline]
+    #[inline(always)]
     fn reduce(&self, i: usize, x: &[f64], mut xi: f64) -> f64 {
         let (start, end) = (self.ptr[i], self.ptr[i + 1]);
         for (&c, &v) in self.col[start..end].iter().zip(&self.val[start..end]) {
