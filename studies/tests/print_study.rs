@@ -4,6 +4,7 @@
 
 use cdpr_bench::core::scenario::{ControllerKind, Designed, FirmwareShaper, Scenario};
 use cdpr_studies::print_study::{Part, auto_frequencies, layer_centre, needs_auto, resolve_auto};
+use cdpr_studies::repeated_modes::groups;
 use cdpr_studies::spatial_modes::{SpatialLoop, SpatialMode, SpatialModes, at_pose};
 
 fn printer(kind: ControllerKind) -> Scenario {
@@ -171,6 +172,21 @@ proptest::proptest! {
 /// and y at the lightly damped 47.8 Hz triple, not the 4.34 Hz one.
 #[test]
 fn auto_frequencies_of_the_computed_torque_loop_are_its_least_damped_modes() {
+    let modes = computed_torque_at_cube_centre();
+    let closed = closed_oscillatory(&modes);
+    let zeta = |m: &SpatialMode| -m.growth / m.growth.hypot(m.omega_rad_s);
+    let least = closed
+        .iter()
+        .min_by(|a, b| zeta(a).total_cmp(&zeta(b)))
+        .unwrap();
+    let [x, y, _] = auto_frequencies(&modes);
+    let hz = least.omega_rad_s / (2.0 * std::f64::consts::PI);
+    assert_eq!((x, y), (Some(hz), Some(hz)), "{closed:?}");
+    assert!((40.0..55.0).contains(&hz), "{hz} Hz");
+}
+
+/// The printer example's computed-torque loop at rest at the sliced cube's first layer's centre.
+fn computed_torque_at_cube_centre() -> SpatialModes {
     let s = printer(ControllerKind::ComputedTorque);
     let gcode = concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -181,19 +197,43 @@ fn auto_frequencies_of_the_computed_torque_loop_are_its_least_damped_modes() {
         gcode: std::fs::read_to_string(gcode).unwrap(),
         layers: 1..=1,
     };
-    let modes = at_pose(&s, layer_centre(&s, &part).unwrap()).unwrap();
-    let closed: Vec<&SpatialMode> = modes
+    at_pose(&s, layer_centre(&s, &part).unwrap()).unwrap()
+}
+
+/// The closed loop's oscillatory modes.
+fn closed_oscillatory(modes: &SpatialModes) -> Vec<&SpatialMode> {
+    modes
         .modes
         .iter()
         .filter(|m| m.linearisation == SpatialLoop::Closed && m.omega_rad_s > 0.0)
+        .collect()
+}
+
+/// The same loop has equal gains per axis: its closed-loop modes come three at a time, and each
+/// triple is named x, y and z once, along the axes (`repeated_modes`). Named from the solver's
+/// own basis (before the eigenspace's was taken), a triple was "vertical (z)" three times over.
+#[test]
+fn the_computed_torque_triples_are_named_x_y_and_z() {
+    let modes = computed_torque_at_cube_centre();
+    let closed = closed_oscillatory(&modes);
+    let lambdas: Vec<(f64, f64)> = closed.iter().map(|m| (m.growth, m.omega_rad_s)).collect();
+    let triples: Vec<Vec<usize>> = groups(&lambdas)
+        .into_iter()
+        .filter(|g| g.len() == 3)
         .collect();
-    let zeta = |m: &SpatialMode| -m.growth / m.growth.hypot(m.omega_rad_s);
-    let least = closed
-        .iter()
-        .min_by(|a, b| zeta(a).total_cmp(&zeta(b)))
-        .unwrap();
-    let [x, y, _] = auto_frequencies(&modes);
-    let hz = least.omega_rad_s / (2.0 * std::f64::consts::PI);
-    assert_eq!((x, y), (Some(hz), Some(hz)), "{closed:?}");
-    assert!((40.0..55.0).contains(&hz), "{hz} Hz");
+    assert!(triples.len() >= 2, "{closed:?}");
+    for triple in triples {
+        let mut names: Vec<&str> = triple.iter().map(|&i| closed[i].name.as_str()).collect();
+        names.sort();
+        assert_eq!(
+            names,
+            ["horizontal (x)", "horizontal (y)", "vertical (z)"],
+            "{closed:?}"
+        );
+        for &i in &triple {
+            let d = closed[i].direction;
+            let along = d.iter().cloned().fold(0.0, f64::max);
+            assert!((along - 1.0).abs() < 1e-9, "{d:?}");
+        }
+    }
 }

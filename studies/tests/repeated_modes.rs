@@ -1,12 +1,9 @@
 //! The directions of modes that share an eigenvalue come from the eigenspace, not from the
 //! eigen-solver's basis of it: any invertible mixing of a group's eigenvectors (what round-off
-//! may hand back) gives the same directions and names, and a loop with equal gains per axis
-//! names each of its triples x, y and z once.
+//! may hand back) gives the same directions and names. (The computed-torque loop's triples,
+//! named x, y and z once each, are checked with the printer's other modes in print_study.rs.)
 
-use cdpr_bench::core::scenario::{ControllerKind, Scenario};
-use cdpr_studies::print_study::{Part, layer_centre};
 use cdpr_studies::repeated_modes::{Complex, axis_basis, groups};
-use cdpr_studies::spatial_modes::{SpatialLoop, SpatialMode, at_pose};
 use proptest::prelude::*;
 
 /// Σ_j a_rj v_j for complex weights `a` (a row of the mixing matrix) over `vectors`.
@@ -124,53 +121,4 @@ fn groups_collect_the_modes_of_one_eigenvalue() {
         (-2.0 + 1e-12, 50.0),
     ];
     assert_eq!(groups(&lambdas), vec![vec![0, 2], vec![1, 4], vec![3]]);
-}
-
-/// The computed-torque loop of the printer example at the sliced cube's centre has equal gains
-/// per axis: its closed-loop modes come three at a time, and each triple is named x, y and z
-/// once, along the axes. Named from the solver's own basis (before the eigenspace's was taken),
-/// a triple was "vertical (z)" three times over.
-#[test]
-fn the_computed_torque_triples_are_named_x_y_and_z() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../examples/printing/hangprinter.toml"
-    );
-    let mut s: Scenario = cdpr_bench::scenario_from_file(std::path::Path::new(path)).unwrap();
-    s.controller.kind = ControllerKind::ComputedTorque;
-    let gcode = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../verify/data/print/cube.gcode"
-    );
-    let part = Part {
-        name: "cube".into(),
-        gcode: std::fs::read_to_string(gcode).unwrap(),
-        layers: 1..=1,
-    };
-    let modes = at_pose(&s, layer_centre(&s, &part).unwrap()).unwrap();
-    let closed: Vec<&SpatialMode> = modes
-        .modes
-        .iter()
-        .filter(|m| m.linearisation == SpatialLoop::Closed && m.omega_rad_s > 0.0)
-        .collect();
-    let lambdas: Vec<(f64, f64)> = closed.iter().map(|m| (m.growth, m.omega_rad_s)).collect();
-    let triples: Vec<Vec<usize>> = groups(&lambdas)
-        .into_iter()
-        .filter(|g| g.len() == 3)
-        .collect();
-    assert!(triples.len() >= 2, "{closed:?}");
-    for triple in triples {
-        let mut names: Vec<&str> = triple.iter().map(|&i| closed[i].name.as_str()).collect();
-        names.sort();
-        assert_eq!(
-            names,
-            ["horizontal (x)", "horizontal (y)", "vertical (z)"],
-            "{closed:?}"
-        );
-        for &i in &triple {
-            let d = closed[i].direction;
-            let along = d.iter().cloned().fold(0.0, f64::max);
-            assert!((along - 1.0).abs() < 1e-9, "{d:?}");
-        }
-    }
 }

@@ -123,20 +123,10 @@ fn nearest_on_the_line(
         let (t, n) = (minimum_norm[i], null[i]);
         let per_s = 1.0 / n;
         let (a, b) = ((limits.t_min - t) * per_s, (limits.t_max - t) * per_s);
-        let moves = n.abs() >= level;
-        from[i] = if !moves {
-            f64::NEG_INFINITY
-        } else if n > 0.0 {
-            a
-        } else {
-            b
-        };
-        to[i] = if !moves {
-            f64::INFINITY
-        } else if n > 0.0 {
-            b
-        } else {
-            a
+        (from[i], to[i]) = match (n.abs() >= level, n > 0.0) {
+            (false, _) => (f64::NEG_INFINITY, f64::INFINITY),
+            (true, true) => (a, b),
+            (true, false) => (b, a),
         };
         lo = lo.max(from[i]);
         hi = hi.min(to[i]);
