@@ -8,8 +8,9 @@
 //! the highest acceleration whose contour error over the printing moves (travel excluded: a
 //! travel's error draws nothing) stays within [`GOOD_CONTOUR`].
 
+use crate::repeated_modes::{self, Complex};
 use crate::spatial_modes::{SpatialLoop, SpatialMode, SpatialModes, at_pose};
-use crate::{Result, pool, repeated_modes};
+use crate::{Result, pool};
 use cdpr_bench::ModelKind;
 use cdpr_bench::core::runner::Observer;
 use cdpr_bench::core::scenario::{
@@ -138,14 +139,14 @@ pub fn auto_frequencies(modes: &SpatialModes) -> [Option<f64>; 3] {
         if any.is_none_or(|(z, _)| zeta < z) {
             any = Some((zeta, hz));
         }
-        let span = orthonormal(
-            closed
-                .iter()
-                .filter(|o| same_eigenvalue(o, m))
-                .map(|o| o.direction),
-        );
+        let motions: Vec<[Complex; 3]> = closed
+            .iter()
+            .filter(|o| same_eigenvalue(o, m))
+            .map(|o| o.direction.map(|c| (c, 0.0)))
+            .collect();
+        let held = repeated_modes::axes_held(&motions);
         for (k, slot) in best.iter_mut().enumerate() {
-            let along = span.iter().map(|q| q[k] * q[k]).sum::<f64>().sqrt();
+            let along = held[k];
             if along >= 0.5 && slot.is_none_or(|(z, _)| zeta < z) {
                 *slot = Some((zeta, hz));
             }
@@ -157,24 +158,6 @@ pub fn auto_frequencies(modes: &SpatialModes) -> [Option<f64>; 3] {
 /// Whether two modes share their eigenvalue ([`repeated_modes::same_eigenvalue`]).
 fn same_eigenvalue(a: &SpatialMode, b: &SpatialMode) -> bool {
     repeated_modes::same_eigenvalue((a.growth, a.omega_rad_s), (b.growth, b.omega_rad_s))
-}
-
-/// An orthonormal basis of the span of `directions` (Gram–Schmidt; a direction within 1e-6 of
-/// the span so far, or a zero one of the controller's states alone, adds nothing).
-fn orthonormal(directions: impl Iterator<Item = [f64; 3]>) -> Vec<[f64; 3]> {
-    let mut basis: Vec<[f64; 3]> = Vec::new();
-    for d in directions {
-        let mut v = d;
-        for q in &basis {
-            let along = (0..3).map(|k| v[k] * q[k]).sum::<f64>();
-            (0..3).for_each(|k| v[k] -= along * q[k]);
-        }
-        let norm = (0..3).map(|k| v[k] * v[k]).sum::<f64>().sqrt();
-        if norm > 1e-6 {
-            basis.push(v.map(|c| c / norm));
-        }
-    }
-    basis
 }
 
 /// Whether the scenario shapes an axis at an `"auto"` frequency.

@@ -78,6 +78,13 @@ pub fn axis_basis(motions: &[[Complex; 3]]) -> Vec<[Complex; 3]> {
     basis
 }
 
+/// How much of each axis x, y, z the span of `motions` holds: the length of the unit axis
+/// vector's projection onto it (1: the span contains the axis; 0: orthogonal to it).
+pub fn axes_held(motions: &[[Complex; 3]]) -> [f64; 3] {
+    let span = orthonormal(motions.iter().copied());
+    std::array::from_fn(|k| norm(&project_axis(&span, k)))
+}
+
 /// An orthonormal basis of the span of `vectors` (Gram–Schmidt; a vector within 1e-6 of its
 /// own length of the span so far, or one below [`NO_MOTION`], adds nothing).
 fn orthonormal(vectors: impl Iterator<Item = [Complex; 3]>) -> Vec<[Complex; 3]> {

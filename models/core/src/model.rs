@@ -93,7 +93,7 @@
 //! ```
 
 use crate::modal_layout::ModalLayout;
-use crate::robot::{Effector, PerCable, Robot, StructureMatrix, Tensions};
+use crate::robot::{Effector, PerCable, Robot, Tensions};
 use crate::scenario::{Scenario, ScenarioError};
 use crate::second_order::SecondOrderForm;
 
@@ -333,25 +333,16 @@ pub trait CableModel<const D: usize> {
 
     /// [`CableModel::rhs`] and [`CableModel::reel_speeds`] of one state in one call, as the
     /// closed loop needs them: a model whose two share work (the massless cables' structure
-    /// matrix) computes it once. `structure` is W at the effector when the loop has formed it
-    /// ([`CableModel::pulls_along_structure_matrix`]). The default calls both.
+    /// matrix) computes it once. The default calls both.
     fn rhs_and_reel_speeds(
         &mut self,
         t: f64,
         state: &[f64],
         tensions: &[f64],
-        _structure: Option<&StructureMatrix<D>>,
         rate: &mut [f64],
     ) -> PerCable {
         self.rhs(t, state, tensions, rate);
         self.reel_speeds(state)
-    }
-
-    /// Whether the cables pull the effector along the structure matrix at its position, W T
-    /// (massless cables): the closed loop then forms W once per right-hand side for the
-    /// controller's distribution and the model ([`CableModel::rhs_and_reel_speeds`]).
-    fn pulls_along_structure_matrix(&self) -> bool {
-        false
     }
 
     /// Whether the model's reels can follow commanded unstrained lengths by moving its reel
@@ -490,13 +481,9 @@ impl<const D: usize, M: CableModel<D> + ?Sized> CableModel<D> for Box<M> {
         t: f64,
         state: &[f64],
         tensions: &[f64],
-        structure: Option<&StructureMatrix<D>>,
         rate: &mut [f64],
     ) -> PerCable {
-        (**self).rhs_and_reel_speeds(t, state, tensions, structure, rate)
-    }
-    fn pulls_along_structure_matrix(&self) -> bool {
-        (**self).pulls_along_structure_matrix()
+        (**self).rhs_and_reel_speeds(t, state, tensions, rate)
     }
     fn reels_follow_lengths(&self) -> bool {
         (**self).reels_follow_lengths()

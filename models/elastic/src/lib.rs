@@ -12,7 +12,7 @@ use cdpr_core::modal_layout::{Dof, ModalLayout};
 use cdpr_core::model::{
     CableModel, Energy, Equilibrium, ModelError, ModelParams, RestRule, check_effector_x,
 };
-use cdpr_core::robot::{Effector, PerCable, Robot, StructureMatrix, Vector, along_vertical};
+use cdpr_core::robot::{Effector, PerCable, Robot, Vector, along_vertical};
 use cdpr_core::scenario::{IntegratorKind, Scenario, ScenarioError, out_of_range};
 use cdpr_numerics::newton::{self, NewtonOptions, StaticProblem};
 
@@ -296,28 +296,16 @@ impl<const D: usize> CableModel<D> for Elastic<D> {
         _t: f64,
         y: &[f64],
         tensions: &[f64],
-        structure: Option<&StructureMatrix<D>>,
         rate: &mut [f64],
     ) -> PerCable {
         let r = &self.robot;
         let e = self.effector(y);
-        let formed;
-        let w = match structure {
-            Some(w) => w,
-            None => {
-                formed = r.structure_matrix(&e.position);
-                &formed
-            }
-        };
+        let w = r.structure_matrix(&e.position);
         let force = w.force(tensions) - along_vertical::<D>(r.effector_mass * r.gravity);
         let acc = force / r.effector_mass;
         rate[..D].copy_from_slice(&y[D..]);
         rate[D..].copy_from_slice(acc.as_slice());
         PerCable::from_fn(r.cables(), |i| w.column(i).dot(&e.velocity))
-    }
-
-    fn pulls_along_structure_matrix(&self) -> bool {
-        true
     }
 
     /// Reeling-in rate = −dl_i/dt = e_i·v: the reel takes in what the effector's approach frees.

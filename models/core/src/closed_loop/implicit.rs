@@ -79,7 +79,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         };
         self.controller
             .trapezoidal_step(s.h, &start, &reference, effector, &mut states[..c]);
-        self.command_with(t, &reference, effector, &states[..c], None)
+        self.command_with(t, &reference, effector, &states[..c])
     }
 
     /// The effector columns of the iteration matrix that close the loop through the tension
@@ -171,7 +171,7 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         let model_state = &y[..n];
         let effector = self.model.effector(model_state);
         let reference = self.reference(t);
-        let cmd = self.command_with(t, &reference, &effector, &y[n..n + c], None);
+        let cmd = self.command_with(t, &reference, &effector, &y[n..n + c]);
         let (power, dissipation) = self.audits_at(t, model_state, &cmd);
         let s = &mut self.step_start;
         s.h = h;
@@ -257,7 +257,7 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         let c = self.controller_len();
         let effector = self.model.effector(&y[..n]);
         let reference = self.reference(t);
-        let cmd = self.command_with(t, &reference, &effector, &y[n..n + c], None);
+        let cmd = self.command_with(t, &reference, &effector, &y[n..n + c]);
         let audits = self.audits_at(t, &y[..n], &cmd);
         self.controller_and_audit_rates(y, (&reference, &effector), cmd.saturated, audits, out);
     }

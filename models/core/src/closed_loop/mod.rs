@@ -19,7 +19,7 @@ pub use spatial::Path;
 use crate::controller::{self, AnyController, Controller, Reference, TensionLimits};
 use crate::model::CableModel;
 use crate::robot::distribution::BOX_TOLERANCE;
-use crate::robot::{Effector, PerCable, Robot, StructureMatrix, Tensions, Vector};
+use crate::robot::{Effector, PerCable, Robot, Tensions, Vector};
 use crate::scenario::{ControllerKind, Scenario};
 use crate::shaper::Impulses;
 use crate::trajectory::Step5;
@@ -258,7 +258,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         let n = self.model_len();
         let effector = self.model.effector(&y[..n]);
         let states = &y[n..n + self.controller_len()];
-        self.command_with(t, &self.reference(t), &effector, states, None)
+        self.command_with(t, &self.reference(t), &effector, states)
     }
 
     /// The commanded tensions at the end (t, y) of an accepted step: those the last
@@ -292,14 +292,8 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         reference: &Reference<D>,
         effector: &Effector<D>,
         states: &[f64],
-        structure: Option<&StructureMatrix<D>>,
     ) -> Command {
-        let out = match structure {
-            Some(w) => self
-                .controller
-                .output_with_structure(reference, effector, states, w),
-            None => self.controller.output(reference, effector, states),
-        };
+        let out = self.controller.output(reference, effector, states);
         let (tensions, mut saturated) = match &self.actuation {
             Actuation::Controller => self.limits.clamp(&out.tensions),
             Actuation::Prescribed(f) => (f(t), false),
@@ -361,22 +355,14 @@ impl<M: CableModel<D>, const D: usize> OdeSystem for ClosedLoop<M, D> {
         let effector = self.model.effector(&y[..n]);
         let reference = self.reference(t);
         let states = &y[n..n + self.controller_len()];
-        // W formed once where both the controller and the model use it.
-        let structure = (self.controller.uses_structure_matrix()
-            && self.model.pulls_along_structure_matrix())
-        .then(|| self.robot().structure_matrix(&effector.position));
-        let cmd = self.command_with(t, &reference, &effector, states, structure.as_ref());
+        let cmd = self.command_with(t, &reference, &effector, states);
         if self.drives_reels_by_length() {
             self.drive_reels(t);
         }
         let (model_rate, tail) = dy.split_at_mut(n);
-        let reel = self.model.rhs_and_reel_speeds(
-            t,
-            &y[..n],
-            &cmd.tensions,
-            structure.as_ref(),
-            model_rate,
-        );
+        let reel = self
+            .model
+            .rhs_and_reel_speeds(t, &y[..n], &cmd.tensions, model_rate);
         let audits = self.audit_rates(&y[..n], &cmd.tensions, &reel);
         self.controller_and_audit_rates(y, (&reference, &effector), cmd.saturated, audits, tail);
         self.last_rhs = LastRhs {

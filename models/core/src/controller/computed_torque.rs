@@ -16,7 +16,7 @@ use super::distribution::TensionSolver;
 use super::error_states::{self, ErrorStates};
 use super::velocity_filter::VelocityFilter;
 use super::{Controller, Measures, Output, Reference, Rest, StepStart};
-use crate::robot::{Effector, Robot, StructureMatrix, Vector};
+use crate::robot::{Effector, Robot, Vector};
 use crate::scenario::{self, ControllerKind};
 
 /// Feedback linearisation with PID error dynamics.
@@ -87,25 +87,12 @@ impl<const D: usize> Controller<D> for ComputedTorque<D> {
         effector: &Effector<D>,
         states: &[f64],
     ) -> Output<D> {
-        let w = self.robot.structure_matrix(&effector.position);
-        self.output_with_structure(reference, effector, states, &w)
-    }
-    fn uses_structure_matrix(&self) -> bool {
-        true
-    }
-    fn output_with_structure(
-        &self,
-        reference: &Reference<D>,
-        effector: &Effector<D>,
-        states: &[f64],
-        structure: &StructureMatrix<D>,
-    ) -> Output<D> {
         let a = self.acceleration(reference, effector, states);
         Output {
             wrench: self.robot.effector_mass * a,
             tensions: self
                 .solver
-                .for_acceleration_with(&self.robot, structure, &a),
+                .for_acceleration(&self.robot, &effector.position, &a),
         }
     }
     fn state_rate(

@@ -160,20 +160,9 @@ impl TensionSolver {
         p: &Vector<D>,
         a: &Vector<D>,
     ) -> Tensions {
-        self.for_acceleration_with(robot, &robot.structure_matrix(p), a)
-    }
-
-    /// [`TensionSolver::for_acceleration`] with W at the effector already formed.
-    #[inline]
-    pub fn for_acceleration_with<const D: usize>(
-        &self,
-        robot: &Robot<D>,
-        w: &StructureMatrix<D>,
-        a: &Vector<D>,
-    ) -> Tensions {
         let v = vertical::<D>();
         let mut lift = *a;
         lift[v] = a[v] + robot.gravity;
-        self.for_force_with(w, &(lift * robot.effector_mass))
+        self.for_force(robot, p, &(lift * robot.effector_mass))
     }
 }

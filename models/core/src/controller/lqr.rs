@@ -20,7 +20,7 @@ use super::distribution::TensionSolver;
 use super::error_states::{self, ErrorStates};
 use super::velocity_filter::VelocityFilter;
 use super::{ControlError, Controller, Measures, Output, Reference, Rest, StepStart};
-use crate::robot::{Effector, Matrix, Robot, StructureMatrix, Tensions, Vector, vertical};
+use crate::robot::{Effector, Matrix, Robot, Tensions, Vector, vertical};
 use crate::scenario::{ControllerKind, Scenario};
 
 /// The LQR design and controller.
@@ -184,19 +184,6 @@ impl<const D: usize> Controller<D> for Lqr<D> {
         effector: &Effector<D>,
         states: &[f64],
     ) -> Output<D> {
-        let w = self.robot.structure_matrix(&effector.position);
-        self.output_with_structure(reference, effector, states, &w)
-    }
-    fn uses_structure_matrix(&self) -> bool {
-        true
-    }
-    fn output_with_structure(
-        &self,
-        reference: &Reference<D>,
-        effector: &Effector<D>,
-        states: &[f64],
-        structure: &StructureMatrix<D>,
-    ) -> Output<D> {
         let ff =
             self.solver
                 .for_acceleration(&self.robot, &reference.position, &reference.acceleration);
@@ -204,13 +191,14 @@ impl<const D: usize> Controller<D> for Lqr<D> {
         self.design_state(reference, effector, states, &mut xi);
         let dt = self.feedback(&xi);
         let tensions = Tensions::from_fn(ff.len(), |i| ff[i] + dt[i]);
-        let wrench = structure.force(&tensions);
+        let w = self.robot.structure_matrix(&effector.position);
+        let wrench = w.force(&tensions);
         if self.robot.cables() > D {
             // A redundant robot: the same wrench, distributed again so that the feedback keeps
             // the box (K ξ alone would push a cable the distribution put on a bound past it).
             return Output {
                 wrench,
-                tensions: self.solver.for_force_with(structure, &wrench),
+                tensions: self.solver.for_force_with(&w, &wrench),
             };
         }
         Output { wrench, tensions }

@@ -63,7 +63,7 @@ pub mod velocity_filter;
 pub use distribution::{TensionDistribution, TensionLimits, TensionSolver, split_tensions};
 pub use pid::{PaperPid, Pid, PidState};
 
-use crate::robot::{Effector, Robot, StructureMatrix, Tensions, Vector, along_vertical};
+use crate::robot::{Effector, Robot, Tensions, Vector, along_vertical};
 use crate::scenario::{ControllerKind, Scenario};
 
 /// The reference at one instant: position, velocity and acceleration [m, m/s, m/s²] of the
@@ -130,26 +130,6 @@ pub trait Controller<const D: usize>: Send + Sync + std::fmt::Debug {
     /// The wrench and tensions for `reference`, the measured `effector` and the `states`.
     fn output(&self, reference: &Reference<D>, effector: &Effector<D>, states: &[f64])
     -> Output<D>;
-
-    /// Whether [`Controller::output`] forms the structure matrix W at the measured effector
-    /// (to distribute its wrench): the loop then forms it once for the controller and a model
-    /// that pulls along it too.
-    fn uses_structure_matrix(&self) -> bool {
-        false
-    }
-
-    /// [`Controller::output`] given the structure matrix W at the measured effector (see
-    /// [`Controller::uses_structure_matrix`]). The same numbers; a controller that needs no W
-    /// there ignores it.
-    fn output_with_structure(
-        &self,
-        reference: &Reference<D>,
-        effector: &Effector<D>,
-        states: &[f64],
-        _structure: &StructureMatrix<D>,
-    ) -> Output<D> {
-        self.output(reference, effector, states)
-    }
 
     /// d/dt of the states (`rate`, [`Controller::state_len`] long); `saturated`: the command is
     /// clamped (anti-windup).
@@ -324,19 +304,6 @@ impl<const D: usize> Controller<D> for AnyController<D> {
         states: &[f64],
     ) -> Output<D> {
         dispatch!(self, c => c.output(reference, effector, states))
-    }
-    fn uses_structure_matrix(&self) -> bool {
-        dispatch!(self, c => Controller::<D>::uses_structure_matrix(c))
-    }
-    #[inline]
-    fn output_with_structure(
-        &self,
-        reference: &Reference<D>,
-        effector: &Effector<D>,
-        states: &[f64],
-        structure: &StructureMatrix<D>,
-    ) -> Output<D> {
-        dispatch!(self, c => c.output_with_structure(reference, effector, states, structure))
     }
     #[inline]
     fn state_rate(

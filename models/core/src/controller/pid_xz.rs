@@ -12,7 +12,7 @@
 
 use super::distribution::TensionSolver;
 use super::{Controller, Measures, Output, Pid, PidState, Reference, Rest, StepStart};
-use crate::robot::{Effector, Robot, StructureMatrix, Vector, along_vertical, vertical};
+use crate::robot::{Effector, Robot, Vector, along_vertical, vertical};
 use crate::scenario::{self, ControllerKind};
 
 /// One PID per axis (x and, in space, y with the x gains; z with its own), decoupled through W.
@@ -93,25 +93,14 @@ impl<const D: usize> Controller<D> for PidXz<D> {
         effector: &Effector<D>,
         states: &[f64],
     ) -> Output<D> {
-        let w = self.robot.structure_matrix(&effector.position);
-        self.output_with_structure(reference, effector, states, &w)
-    }
-    fn uses_structure_matrix(&self) -> bool {
-        true
-    }
-    fn output_with_structure(
-        &self,
-        reference: &Reference<D>,
-        effector: &Effector<D>,
-        states: &[f64],
-        structure: &StructureMatrix<D>,
-    ) -> Output<D> {
         let e = Self::errors(reference, effector);
         let force = Vector::<D>::from_fn(|k, _| self.axes[k].force(e[k], state(states, k)));
         let pull = force + along_vertical::<D>(self.weight());
         Output {
             wrench: force,
-            tensions: self.solver.for_force_with(structure, &pull),
+            tensions: self
+                .solver
+                .for_force(&self.robot, &effector.position, &pull),
         }
     }
     fn state_rate(
