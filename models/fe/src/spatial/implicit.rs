@@ -120,8 +120,7 @@ impl SecondOrderForm for FeSpatial {
     }
 
     fn residual(&mut self, state: &[f64], qdd: &[f64], tensions: &[f64], r: &mut [f64]) {
-        self.assemble(state, tensions);
-        self.system.residual(qdd, r);
+        self.element_residual(state, qdd, tensions, r);
     }
 
     /// Element by element ([`super::blocks`]), under tension reels or, rewritten for Du's

@@ -12,6 +12,7 @@
 
 mod blocks;
 mod implicit;
+mod lanes;
 mod prescribed;
 mod star;
 mod statics;
@@ -42,6 +43,8 @@ pub struct FeSpatial {
     coefficients: Vec<MassCoefficients>,
     stored_coefficients: MassCoefficients,
     system: StarSystem,
+    /// The implicit residual's span element rows ([`lanes`]).
+    rows: lanes::StarRows,
     /// Accelerations of the free nodes (cable-major) and of (l_i, ρ_i), per solve.
     node_accelerations: Vec<Vector3<f64>>,
     border_accelerations: Vec<[f64; 2]>,
@@ -127,6 +130,9 @@ impl FeSpatial {
     ) -> Self {
         let m = robot.cables();
         let w = |k: usize| 1.0 - k as f64 / n as f64;
+        let coefficients: Vec<MassCoefficients> = (1..=n)
+            .map(|e| MassCoefficients::new(mass, w(e - 1), w(e)))
+            .collect();
         Self {
             robot,
             elements: n,
@@ -134,9 +140,8 @@ impl FeSpatial {
             material,
             axial_damping,
             reels,
-            coefficients: (1..=n)
-                .map(|e| MassCoefficients::new(mass, w(e - 1), w(e)))
-                .collect(),
+            rows: lanes::StarRows::new(m, &coefficients),
+            coefficients,
             stored_coefficients: MassCoefficients::new(mass, 0.0, 1.0),
             system: StarSystem::new(m, n - 1),
             node_accelerations: vec![Vector3::zeros(); m * (n - 1)],

@@ -225,45 +225,6 @@ impl StarSystem {
     }
 }
 
-impl StarSystem {
-    /// R = M q'' − F of the assembled system at the accelerations `qdd` (q's layout: the arms'
-    /// nodes, P, then (l_i'', ρ_i'') per arm) into `r`.
-    pub fn residual(&self, qdd: &[f64], r: &mut [f64]) {
-        let (m, nn) = (self.arms, self.nodes);
-        let at = |i: usize| Vector3::new(qdd[3 * i], qdd[3 * i + 1], qdd[3 * i + 2]);
-        let p = 3 * m * nn;
-        let a_p = Vector3::new(qdd[p], qdd[p + 1], qdd[p + 2]);
-        let mut r_p = a_p * self.effector_mass - self.effector_force;
-        for arm in 0..m {
-            let o = arm * nn;
-            let (li, ri) = (p + 3 + 2 * arm, p + 4 + 2 * arm);
-            let (l_acc, rho_acc) = (qdd[li], qdd[ri]);
-            let [d_ll, d_lr, d_rr, f_l, f_r] = self.border[arm];
-            let mut r_l = d_ll * l_acc + d_lr * rho_acc - f_l + self.effector_l[arm].dot(&a_p);
-            for k in 0..nn {
-                let a = at(o + k);
-                let mut row =
-                    a * self.diag[o + k] + self.l_column[o + k] * l_acc - self.force[o + k];
-                if k > 0 {
-                    row += at(o + k - 1) * self.off[o + k - 1];
-                }
-                if k + 1 < nn {
-                    row += at(o + k + 1) * self.off[o + k];
-                } else {
-                    row += a_p * self.node_effector[arm];
-                    r_p += a * self.node_effector[arm];
-                }
-                r[3 * (o + k)..3 * (o + k) + 3].copy_from_slice(row.as_slice());
-                r_l += self.l_column[o + k].dot(&a);
-            }
-            r_p += self.effector_l[arm] * l_acc;
-            r[li] = r_l;
-            r[ri] = d_lr * l_acc + d_rr * rho_acc - f_r;
-        }
-        r[p..p + 3].copy_from_slice(r_p.as_slice());
-    }
-}
-
 /// Solves the symmetric positive definite `a` (n × n, row-major, overwritten by its Cholesky
 /// factor) x = b in place of `b`; false if `a` is not positive definite.
 fn cholesky_solve(a: &mut [f64], b: &mut [f64], n: usize) -> bool {

@@ -1,0 +1,393 @@
+//! The implicit residual of the spatial FE robot element by element (MODELS.md FE.9.3), its span
+//! elements as one loop the compiler runs several elements at a time, as the plane's chain
+//! ([`crate::lanes`]).
+//!
+//! Every arm's nodes are laid out arm after arm in columns — its pulley at rest, its free nodes
+//! 1 … N − 1, the effector — so an arm's element e is the consecutive pair (e − 1, e) and one
+//! loop over all consecutive pairs runs [`element::residual_at_chord`] on every lane (the m − 1
+//! pairs that join an arm's effector to the next arm's pulley are computed and never read).
+//! Each lane does the scalar kernel's operations in its order, so the rows are the scalar
+//! kernel's bit for bit (a test below checks it). The rows are then summed into R per node, per
+//! l_i and at the effector, with each stored element's rows (one per cable, scalar) and the
+//! effector's own mass and weight.
+//!
+//! Why: the star's assembly forms M and F (FE.5.3's terms, then M q'' − F), one element at a
+//! time, each waiting on its chord's square root and division; the collected rows need fewer
+//! operations and the lanes use the vector width the scalar code leaves idle.
+
+use super::FeSpatial;
+use crate::element::{self, Chord, ElementState, MassCoefficients, Material};
+use nalgebra::Vector3;
+
+/// The span elements' fixed mass coefficients, their spans and the nodes they read, arm after
+/// arm: an arm's element e at index a (N + 1) + e − 1 (its nodes at that index and the next).
+#[derive(Debug, Clone, PartialEq, Default)]
+struct Elements {
+    c1: Vec<f64>,
+    c2: Vec<f64>,
+    alpha: Vec<f64>,
+    beta: Vec<f64>,
+    gamma: Vec<f64>,
+    /// h' of a span element, 1/N.
+    h_prime: f64,
+    /// Per element, its span's l' [m/s], h = l/N [m], 1/h, and l'' [m/s²].
+    l_rate: Vec<f64>,
+    h: Vec<f64>,
+    inv_h: Vec<f64>,
+    l_acceleration: Vec<f64>,
+    /// The nodes' positions, velocities and accelerations (x, y, z each), N + 1 per arm.
+    nodes: [Vec<f64>; 9],
+}
+
+/// The span elements and their rows of R (allocated once).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(super) struct StarRows {
+    elements: Elements,
+    /// Rows (x, y, z) of element i's node a and node b, and its row l [N].
+    row_a: [Vec<f64>; 3],
+    row_b: [Vec<f64>; 3],
+    row_l: Vec<f64>,
+}
+
+impl StarRows {
+    /// For `arms` ≥ 1 arms of N elements with the coefficients of elements e = 1 … N
+    /// (index e − 1).
+    pub fn new(arms: usize, coefficients: &[MassCoefficients]) -> Self {
+        let n = coefficients.len();
+        let len = arms * (n + 1) - 1;
+        // The joining pairs take the last element's coefficients: any finite numbers do.
+        let column = |f: fn(&MassCoefficients) -> f64| {
+            (0..len)
+                .map(|i| f(&coefficients[(i % (n + 1)).min(n - 1)]))
+                .collect::<Vec<f64>>()
+        };
+        Self {
+            elements: Elements {
+                c1: column(|k| k.c1),
+                c2: column(|k| k.c2),
+                alpha: column(|k| k.alpha),
+                beta: column(|k| k.beta),
+                gamma: column(|k| k.gamma),
+                h_prime: 1.0 / n as f64,
+                l_rate: vec![0.0; len],
+                h: vec![1.0; len],
+                inv_h: vec![1.0; len],
+                l_acceleration: vec![0.0; len],
+                nodes: std::array::from_fn(|_| vec![0.0; len + 1]),
+            },
+            row_a: std::array::from_fn(|_| vec![0.0; len]),
+            row_b: std::array::from_fn(|_| vec![0.0; len]),
+            row_l: vec![0.0; len],
+        }
+    }
+
+    /// The rows of every span element from the nodes and spans set.
+    pub fn evaluate(&mut self, mat: &Material, damping: f64) {
+        let [ra_x, ra_y, ra_z] = &mut self.row_a;
+        let [rb_x, rb_y, rb_z] = &mut self.row_b;
+        let out = (ra_x, ra_y, ra_z, rb_x, rb_y, rb_z, &mut self.row_l);
+        // Undamped, the damping branch is compiled out: in lanes a branch becomes a select,
+        // which would evaluate the damping terms' square root and divisions on every element.
+        if damping == 0.0 {
+            self.elements
+                .rows::<false>(mat, 0.0, out.0, out.1, out.2, out.3, out.4, out.5, out.6);
+        } else {
+            self.elements.rows::<true>(
+                mat, damping, out.0, out.1, out.2, out.3, out.4, out.5, out.6,
+            );
+        }
+    }
+}
+
+impl Elements {
+    /// The rows into the seven output columns. Kept out of line with each column its own
+    /// argument: the compiler then knows the outputs alias neither the inputs nor each other,
+    /// and vectorises the loop without runtime overlap checks (which it gives up on for this
+    /// many columns).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
+    fn rows<const DAMPED: bool>(
+        &self,
+        mat: &Material,
+        damping: f64,
+        ra_x: &mut [f64],
+        ra_y: &mut [f64],
+        ra_z: &mut [f64],
+        rb_x: &mut [f64],
+        rb_y: &mut [f64],
+        rb_z: &mut [f64],
+        rl: &mut [f64],
+    ) {
+        let damping = if DAMPED { damping } else { 0.0 };
+        let m = rl.len();
+        // Every slice cut to its length here, so the loop carries no bounds checks.
+        let [px, py, pz, vx, vy, vz, ax, ay, az] = &self.nodes;
+        let nodes = [
+            &px[..m + 1],
+            &py[..m + 1],
+            &pz[..m + 1],
+            &vx[..m + 1],
+            &vy[..m + 1],
+            &vz[..m + 1],
+            &ax[..m + 1],
+            &ay[..m + 1],
+            &az[..m + 1],
+        ];
+        let (c1, c2, alpha, beta, gamma) = (
+            &self.c1[..m],
+            &self.c2[..m],
+            &self.alpha[..m],
+            &self.beta[..m],
+            &self.gamma[..m],
+        );
+        let (l_rate, h, inv_h, l_acceleration) = (
+            &self.l_rate[..m],
+            &self.h[..m],
+            &self.inv_h[..m],
+            &self.l_acceleration[..m],
+        );
+        let (ra_x, ra_y, ra_z) = (&mut ra_x[..m], &mut ra_y[..m], &mut ra_z[..m]);
+        let (rb_x, rb_y, rb_z) = (&mut rb_x[..m], &mut rb_y[..m], &mut rb_z[..m]);
+        for i in 0..m {
+            let at = |j: usize, q: usize| {
+                Vector3::new(nodes[3 * q][j], nodes[3 * q + 1][j], nodes[3 * q + 2][j])
+            };
+            let s = ElementState {
+                ra: at(i, 0),
+                rb: at(i + 1, 0),
+                va: at(i, 1),
+                vb: at(i + 1, 1),
+                l_rate: l_rate[i],
+                h: h[i],
+                inv_h: inv_h[i],
+                h_prime: self.h_prime,
+            };
+            let k = MassCoefficients {
+                c1: c1[i],
+                c2: c2[i],
+                alpha: alpha[i],
+                beta: beta[i],
+                gamma: gamma[i],
+            };
+            let (row_a, row_b, row_l) = element::residual_at_chord(
+                mat,
+                &k,
+                &s,
+                damping,
+                Chord::of(&s),
+                at(i, 2),
+                at(i + 1, 2),
+                l_acceleration[i],
+            );
+            ra_x[i] = row_a.x;
+            ra_y[i] = row_a.y;
+            ra_z[i] = row_a.z;
+            rb_x[i] = row_b.x;
+            rb_y[i] = row_b.y;
+            rb_z[i] = row_b.z;
+            rl[i] = row_l;
+        }
+    }
+}
+
+impl FeSpatial {
+    /// R = M(q) q'' − F(q, q', T) at (`state`, `qdd`) into `r` (FE.9.3) from the element rows:
+    /// each free node's from its two elements; the effector's from its own mass and weight and
+    /// each arm's last element; each l_i's from its span's elements and its stored element; each
+    /// ρ_i's from the stored element along r_i and the commanded tension T_i (FE.5.3). Driven
+    /// by length (Du's form, FE.5.6) the spans see l_i'' = the command, the l_i rows read
+    /// l_i'' − the command and the ρ_i rows ρ_i'' (the stored cable is on the reel).
+    pub(super) fn element_residual(
+        &mut self,
+        state: &[f64],
+        qdd: &[f64],
+        tensions: &[f64],
+        r: &mut [f64],
+    ) {
+        let mut rows = std::mem::take(&mut self.rows);
+        self.gather_rows(&mut rows, state, qdd);
+        rows.evaluate(&self.material, self.axial_damping);
+        self.sum_rows(&rows, state, qdd, tensions, r);
+        self.rows = rows;
+    }
+
+    /// Each arm's nodes (its pulley at rest, its free nodes, the effector) and span into `rows`.
+    fn gather_rows(&self, rows: &mut StarRows, state: &[f64], qdd: &[f64]) {
+        let (n, np) = (self.elements, self.positions_len());
+        let (positions, velocities) = state.split_at(np);
+        let sources = [positions, velocities, qdd];
+        let p = self.effector_index(0);
+        let el = &mut rows.elements;
+        let len = el.h.len();
+        for cable in 0..self.robot.cables() {
+            let (o, li) = (cable * (n + 1), self.l_index(cable));
+            let l_acceleration = if self.length_driven {
+                self.commanded_l_acceleration(state, cable)
+            } else {
+                qdd[li]
+            };
+            let h = state[li] / n as f64;
+            let span = o..(o + n + 1).min(len);
+            el.h[span.clone()].fill(h);
+            el.inv_h[span.clone()].fill(1.0 / h);
+            el.l_rate[span.clone()].fill(velocities[li]);
+            el.l_acceleration[span].fill(l_acceleration);
+            // The arm's columns cut once (a store through a column then cannot move another).
+            let columns = el.nodes.each_mut().map(|c| &mut c[o..o + n + 1]);
+            let pulley = self.pulley(cable);
+            for axis in 0..3 {
+                columns[axis][0] = pulley[axis];
+                columns[3 + axis][0] = 0.0;
+                columns[6 + axis][0] = 0.0;
+            }
+            // The arm's free nodes lie together in q, (x, y, z) per node.
+            let free = 3 * cable * (n - 1);
+            for (q, source) in sources.iter().enumerate() {
+                let nodes = source[free..free + 3 * (n - 1)].chunks_exact(3);
+                for (k, node) in nodes.enumerate() {
+                    for axis in 0..3 {
+                        columns[3 * q + axis][k + 1] = node[axis];
+                    }
+                }
+            }
+            for (q, source) in sources.iter().enumerate() {
+                for axis in 0..3 {
+                    columns[3 * q + axis][n] = source[p + axis];
+                }
+            }
+        }
+    }
+
+    /// R from the evaluated element rows (see [`Self::element_residual`]).
+    fn sum_rows(
+        &self,
+        rows: &StarRows,
+        state: &[f64],
+        qdd: &[f64],
+        tensions: &[f64],
+        r: &mut [f64],
+    ) {
+        let n = self.elements;
+        let p = self.effector_index(0);
+        let row = |columns: &[Vec<f64>; 3], i: usize| {
+            Vector3::new(columns[0][i], columns[1][i], columns[2][i])
+        };
+        let weight = Vector3::new(0.0, 0.0, self.material.gravity);
+        let mut r_p =
+            (Vector3::new(qdd[p], qdd[p + 1], qdd[p + 2]) + weight) * self.robot.effector_mass;
+        for (cable, tension) in tensions.iter().enumerate().take(self.robot.cables()) {
+            // Free node k's rows: element k's node b and element k + 1's node a.
+            let (o, free) = (cable * (n + 1), 3 * cable * (n - 1));
+            let nodes = &mut r[free..free + 3 * (n - 1)];
+            for axis in 0..3 {
+                let (b, a) = (
+                    &rows.row_b[axis][o..o + n - 1],
+                    &rows.row_a[axis][o + 1..o + n],
+                );
+                for ((node, b), a) in nodes.chunks_exact_mut(3).zip(b).zip(a) {
+                    node[axis] = b + a;
+                }
+            }
+            r_p += row(&rows.row_b, o + n - 1);
+            let (li, rho) = (self.l_index(cable), self.l_index(cable) + 1);
+            if self.length_driven {
+                r[li] = qdd[li] - rows.elements.l_acceleration[o];
+                r[rho] = qdd[rho];
+            } else {
+                let span: f64 = rows.row_l[o..o + n].iter().sum();
+                let (reel_row, l_row) = self.stored_rows(state, qdd, cable);
+                r[li] = span + l_row;
+                r[rho] = reel_row - tension;
+            }
+        }
+        r[p..p + 3].copy_from_slice(r_p.as_slice());
+    }
+
+    /// The stored element's rows of `cable`: along r_i at its reel end (R = A + ρ r, a_R =
+    /// ρ'' r), and l [N] (h' = −1).
+    fn stored_rows(&self, state: &[f64], qdd: &[f64], cable: usize) -> (f64, f64) {
+        let (li, reel) = (self.l_index(cable), self.reels[cable]);
+        let s = self.stored_element(state, cable);
+        let (r_reel, _, r_l) = element::residual_at_chord(
+            &self.material,
+            &self.stored_coefficients,
+            &s,
+            self.axial_damping,
+            Chord::of(&s),
+            reel * qdd[li + 1],
+            Vector3::zeros(),
+            qdd[li],
+        );
+        (r_reel.dot(&reel), r_l)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::FeMass;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Every lane's rows are the scalar element kernel's bit for bit, for each element of
+        /// 1 … 8 arms of N = 1 … 12 elements (lengths that leave a partial vector), nodes, spans
+        /// and accelerations random, with and without damping, lumped and consistent mass.
+        #[test]
+        fn lanes_are_the_scalar_kernel_bit_for_bit(
+            arms in 1usize..9,
+            n in 1usize..13,
+            lumped in any::<bool>(),
+            damping in prop_oneof![Just(0.0), 0.5f64..5.0],
+            seed in prop::collection::vec(-1.0f64..1.0, 31),
+        ) {
+            let mass = if lumped { FeMass::Lumped } else { FeMass::Consistent };
+            let w = |k: usize| 1.0 - k as f64 / n as f64;
+            let coefficients: Vec<_> =
+                (1..=n).map(|e| MassCoefficients::new(mass, w(e - 1), w(e))).collect();
+            let mat = Material { ea: 1.0e4, mu: 0.05, gravity: 9.81 };
+            let mut rows = StarRows::new(arms, &coefficients);
+            // Values spread from the seed; consecutive nodes about 0.1 m apart, so every
+            // element is taut or slack by the draw.
+            let value = |j: usize, k: usize| seed[(7 * j + 3 * k) % seed.len()] * (1.0 + 0.01 * k as f64);
+            let el = &mut rows.elements;
+            for j in 0..arms * (n + 1) {
+                for k in 0..9 {
+                    el.nodes[k][j] = if k < 3 { 0.1 * j as f64 + 0.05 * value(j, k) } else { value(j, k) };
+                }
+            }
+            for a in 0..arms {
+                let l = 0.5 + 0.1 * seed[a % seed.len()];
+                for e in 1..=n {
+                    let i = a * (n + 1) + e - 1;
+                    el.h[i] = l / n as f64;
+                    el.inv_h[i] = 1.0 / el.h[i];
+                    el.l_rate[i] = seed[(a + 5) % seed.len()];
+                    el.l_acceleration[i] = seed[(a + 11) % seed.len()];
+                }
+            }
+            rows.evaluate(&mat, damping);
+            let el = &rows.elements;
+            let node = |q: usize, j: usize| Vector3::new(el.nodes[3 * q][j], el.nodes[3 * q + 1][j], el.nodes[3 * q + 2][j]);
+            let same = |u: Vector3<f64>, v: [f64; 3]| (0..3).all(|k| u[k].to_bits() == v[k].to_bits());
+            for a in 0..arms {
+                for e in 1..=n {
+                    let i = a * (n + 1) + e - 1;
+                    let s = ElementState::new(
+                        (node(0, i), node(1, i)),
+                        (node(0, i + 1), node(1, i + 1)),
+                        el.l_rate[i],
+                        el.h[i],
+                        1.0 / n as f64,
+                    );
+                    let (ra, rb, rl) = element::residual_at_chord(
+                        &mat, &coefficients[e - 1], &s, damping, Chord::of(&s),
+                        node(2, i), node(2, i + 1), el.l_acceleration[i],
+                    );
+                    let at = |r: &[Vec<f64>; 3]| [r[0][i], r[1][i], r[2][i]];
+                    prop_assert!(same(ra, at(&rows.row_a)) && same(rb, at(&rows.row_b)), "arm {a} element {e}");
+                    prop_assert_eq!(rl.to_bits(), rows.row_l[i].to_bits(), "arm {} element {}", a, e);
+                }
+            }
+        }
+    }
+}
