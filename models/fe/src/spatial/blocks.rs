@@ -20,7 +20,7 @@ const LOCAL: usize = 7;
 
 /// One additive block of R.
 #[derive(Debug, Clone, Copy)]
-enum Block {
+pub(super) enum Block {
     /// Free element e (1 … N) of a cable: local (r_a, r_b, l).
     Free { cable: usize, e: usize },
     /// The stored element: local (ρ, l).
@@ -30,10 +30,10 @@ enum Block {
 }
 
 /// Local unknowns of a block and their global indices (None: the fixed pulley node).
-type LocalDofs = [Option<usize>; LOCAL];
+pub(super) type LocalDofs = [Option<usize>; LOCAL];
 
 /// A block's local positions, velocities and accelerations.
-type Local = [[f64; LOCAL]; 3];
+pub(super) type Local = [[f64; LOCAL]; 3];
 
 impl FeSpatial {
     fn blocks(&self) -> impl Iterator<Item = Block> + '_ {
@@ -46,7 +46,7 @@ impl FeSpatial {
             .chain([Block::Effector])
     }
 
-    fn block_dofs(&self, block: Block) -> (LocalDofs, usize) {
+    pub(super) fn block_dofs(&self, block: Block) -> (LocalDofs, usize) {
         let mut dofs = [None; LOCAL];
         match block {
             Block::Free { cable, e } => {
@@ -76,7 +76,13 @@ impl FeSpatial {
     }
 
     /// The block's local unknowns from the global state; the pulley node sits still at A_i.
-    fn gather(&self, block: Block, dofs: &LocalDofs, state: &[f64], qdd: &[f64]) -> Local {
+    pub(super) fn gather(
+        &self,
+        block: Block,
+        dofs: &LocalDofs,
+        state: &[f64],
+        qdd: &[f64],
+    ) -> Local {
         let np = self.positions_len();
         let mut local = [[0.0; LOCAL]; 3];
         for (k, dof) in dofs.iter().enumerate() {
@@ -212,12 +218,20 @@ impl FeSpatial {
         if self.block_slots.is_empty() {
             self.block_slots = self.block_slots();
         }
+        self.free_block_matrices(state, qdd, weights);
         values.fill(0.0);
         let mut slots = self.block_slots.iter();
         for block in self.blocks() {
             let (dofs, len) = self.block_dofs(block);
-            let local = self.gather(block, &dofs, state, qdd);
-            let matrix = self.local_matrix(block, &dofs[..len], &local, weights);
+            let matrix = match block {
+                Block::Free { cable, e } => {
+                    self.block_lanes.matrices[cable * self.elements + e - 1]
+                }
+                _ => {
+                    let local = self.gather(block, &dofs, state, qdd);
+                    self.local_matrix(block, &dofs[..len], &local, weights)
+                }
+            };
             for row in (0..len).filter(|&r| dofs[r].is_some()) {
                 for col in (0..len).filter(|&c| dofs[c].is_some()) {
                     let slot = slots.next().expect("one slot per entry");
@@ -228,7 +242,7 @@ impl FeSpatial {
     }
 
     /// The block's weighted derivative matrix local[row][col].
-    fn local_matrix(
+    pub(super) fn local_matrix(
         &self,
         block: Block,
         dofs: &[Option<usize>],

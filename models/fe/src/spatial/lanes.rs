@@ -19,34 +19,186 @@ use super::FeSpatial;
 use crate::element::{self, Chord, ElementState, MassCoefficients, Material};
 use nalgebra::Vector3;
 
-/// The span elements' fixed mass coefficients, their spans and the nodes they read, arm after
-/// arm: an arm's element e at index a (N + 1) + e − 1 (its nodes at that index and the next).
+/// The span elements' fixed mass coefficients, element by element, and N.
 #[derive(Debug, Clone, PartialEq, Default)]
-struct Elements {
+pub(super) struct Coefficients {
     c1: Vec<f64>,
     c2: Vec<f64>,
     alpha: Vec<f64>,
     beta: Vec<f64>,
     gamma: Vec<f64>,
-    /// h' of a span element, 1/N.
+    /// Elements per span N, and h' = 1/N.
+    n: f64,
     h_prime: f64,
-    /// Per element, its span's l' [m/s], h = l/N [m], 1/h, and l'' [m/s²].
-    l_rate: Vec<f64>,
-    h: Vec<f64>,
-    inv_h: Vec<f64>,
-    l_acceleration: Vec<f64>,
-    /// The nodes' positions, velocities and accelerations (x, y, z each), N + 1 per arm.
-    nodes: [Vec<f64>; 9],
 }
 
-/// The span elements and their rows of R (allocated once).
+impl Coefficients {
+    /// Element i's coefficients `per_element[i]`, for spans of N = `n` elements.
+    pub fn new<'a>(n: usize, per_element: impl Iterator<Item = &'a MassCoefficients>) -> Self {
+        let mut k = Self {
+            n: n as f64,
+            h_prime: 1.0 / n as f64,
+            ..Self::default()
+        };
+        for c in per_element {
+            k.c1.push(c.c1);
+            k.c2.push(c.c2);
+            k.alpha.push(c.alpha);
+            k.beta.push(c.beta);
+            k.gamma.push(c.gamma);
+        }
+        k
+    }
+}
+
+/// One evaluation's inputs, element by element: node a's and node b's position, velocity and
+/// acceleration (x, y, z each), and the span's l [m], l' [m/s] and l'' [m/s²].
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Inputs<'a> {
+    pub a: [&'a [f64]; 9],
+    pub b: [&'a [f64]; 9],
+    pub l: &'a [f64],
+    pub l_rate: &'a [f64],
+    pub l_acceleration: &'a [f64],
+}
+
+/// Each element's rows of R: node a's and node b's (x, y, z) and l's [N].
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(super) struct Rows {
+    pub a: [Vec<f64>; 3],
+    pub b: [Vec<f64>; 3],
+    pub l: Vec<f64>,
+}
+
+impl Rows {
+    pub fn new(len: usize) -> Self {
+        Self {
+            a: std::array::from_fn(|_| vec![0.0; len]),
+            b: std::array::from_fn(|_| vec![0.0; len]),
+            l: vec![0.0; len],
+        }
+    }
+
+    /// Element i's rows in the block's local order (r_a, r_b, l).
+    #[inline]
+    pub fn local(&self, i: usize) -> [f64; 7] {
+        let (a, b) = (&self.a, &self.b);
+        [
+            a[0][i], a[1][i], a[2][i], b[0][i], b[1][i], b[2][i], self.l[i],
+        ]
+    }
+
+    /// The rows of every element of `input` ([`element::residual_at_chord`] in lanes).
+    pub fn evaluate(&mut self, k: &Coefficients, mat: &Material, damping: f64, input: &Inputs) {
+        let [ra_x, ra_y, ra_z] = &mut self.a;
+        let [rb_x, rb_y, rb_z] = &mut self.b;
+        let out = (ra_x, ra_y, ra_z, rb_x, rb_y, rb_z, &mut self.l);
+        // Undamped, the damping branch is compiled out: in lanes a branch becomes a select,
+        // which would evaluate the damping terms' square root and divisions on every element.
+        if damping == 0.0 {
+            rows::<false>(
+                k, mat, 0.0, input, out.0, out.1, out.2, out.3, out.4, out.5, out.6,
+            );
+        } else {
+            rows::<true>(
+                k, mat, damping, input, out.0, out.1, out.2, out.3, out.4, out.5, out.6,
+            );
+        }
+    }
+}
+
+/// The rows into the seven output columns, one element per lane. Kept out of line with each
+/// column its own argument: the compiler then knows the outputs alias neither the inputs nor
+/// each other, and vectorises the loop without runtime overlap checks (which it gives up on for
+/// this many columns).
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn rows<const DAMPED: bool>(
+    k: &Coefficients,
+    mat: &Material,
+    damping: f64,
+    input: &Inputs,
+    ra_x: &mut [f64],
+    ra_y: &mut [f64],
+    ra_z: &mut [f64],
+    rb_x: &mut [f64],
+    rb_y: &mut [f64],
+    rb_z: &mut [f64],
+    rl: &mut [f64],
+) {
+    let damping = if DAMPED { damping } else { 0.0 };
+    let m = rl.len();
+    // Every slice cut to its length here, so the loop carries no bounds checks.
+    let a = input.a.map(|c| &c[..m]);
+    let b = input.b.map(|c| &c[..m]);
+    let (c1, c2, alpha, beta, gamma) = (
+        &k.c1[..m],
+        &k.c2[..m],
+        &k.alpha[..m],
+        &k.beta[..m],
+        &k.gamma[..m],
+    );
+    let (l, l_rate, l_acceleration) = (
+        &input.l[..m],
+        &input.l_rate[..m],
+        &input.l_acceleration[..m],
+    );
+    let (ra_x, ra_y, ra_z) = (&mut ra_x[..m], &mut ra_y[..m], &mut ra_z[..m]);
+    let (rb_x, rb_y, rb_z) = (&mut rb_x[..m], &mut rb_y[..m], &mut rb_z[..m]);
+    for i in 0..m {
+        let at =
+            |c: &[&[f64]; 9], q: usize| Vector3::new(c[3 * q][i], c[3 * q + 1][i], c[3 * q + 2][i]);
+        // h and 1/h as `ElementState::new` forms them.
+        let h = l[i] / k.n;
+        let s = ElementState {
+            ra: at(&a, 0),
+            rb: at(&b, 0),
+            va: at(&a, 1),
+            vb: at(&b, 1),
+            l_rate: l_rate[i],
+            h,
+            inv_h: 1.0 / h,
+            h_prime: k.h_prime,
+        };
+        let coefficients = MassCoefficients {
+            c1: c1[i],
+            c2: c2[i],
+            alpha: alpha[i],
+            beta: beta[i],
+            gamma: gamma[i],
+        };
+        let (row_a, row_b, row_l) = element::residual_at_chord(
+            mat,
+            &coefficients,
+            &s,
+            damping,
+            Chord::of(&s),
+            at(&a, 2),
+            at(&b, 2),
+            l_acceleration[i],
+        );
+        ra_x[i] = row_a.x;
+        ra_y[i] = row_a.y;
+        ra_z[i] = row_a.z;
+        rb_x[i] = row_b.x;
+        rb_y[i] = row_b.y;
+        rb_z[i] = row_b.z;
+        rl[i] = row_l;
+    }
+}
+
+/// The residual's span elements, arm after arm: an arm's element e at index a (N + 1) + e − 1,
+/// its nodes at that index and the next (allocated once).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub(super) struct StarRows {
-    elements: Elements,
-    /// Rows (x, y, z) of element i's node a and node b, and its row l [N].
-    row_a: [Vec<f64>; 3],
-    row_b: [Vec<f64>; 3],
-    row_l: Vec<f64>,
+    coefficients: Coefficients,
+    /// The nodes' positions, velocities and accelerations (x, y, z each), N + 1 per arm.
+    nodes: [Vec<f64>; 9],
+    /// Per element, its span's l [m], l' [m/s] and l'' [m/s²].
+    l: Vec<f64>,
+    l_rate: Vec<f64>,
+    l_acceleration: Vec<f64>,
+    rows: Rows,
 }
 
 impl StarRows {
@@ -56,137 +208,28 @@ impl StarRows {
         let n = coefficients.len();
         let len = arms * (n + 1) - 1;
         // The joining pairs take the last element's coefficients: any finite numbers do.
-        let column = |f: fn(&MassCoefficients) -> f64| {
-            (0..len)
-                .map(|i| f(&coefficients[(i % (n + 1)).min(n - 1)]))
-                .collect::<Vec<f64>>()
-        };
+        let per_element = (0..len).map(|i| &coefficients[(i % (n + 1)).min(n - 1)]);
         Self {
-            elements: Elements {
-                c1: column(|k| k.c1),
-                c2: column(|k| k.c2),
-                alpha: column(|k| k.alpha),
-                beta: column(|k| k.beta),
-                gamma: column(|k| k.gamma),
-                h_prime: 1.0 / n as f64,
-                l_rate: vec![0.0; len],
-                h: vec![1.0; len],
-                inv_h: vec![1.0; len],
-                l_acceleration: vec![0.0; len],
-                nodes: std::array::from_fn(|_| vec![0.0; len + 1]),
-            },
-            row_a: std::array::from_fn(|_| vec![0.0; len]),
-            row_b: std::array::from_fn(|_| vec![0.0; len]),
-            row_l: vec![0.0; len],
+            coefficients: Coefficients::new(n, per_element),
+            nodes: std::array::from_fn(|_| vec![0.0; len + 1]),
+            l: vec![1.0; len],
+            l_rate: vec![0.0; len],
+            l_acceleration: vec![0.0; len],
+            rows: Rows::new(len),
         }
     }
 
     /// The rows of every span element from the nodes and spans set.
     pub fn evaluate(&mut self, mat: &Material, damping: f64) {
-        let [ra_x, ra_y, ra_z] = &mut self.row_a;
-        let [rb_x, rb_y, rb_z] = &mut self.row_b;
-        let out = (ra_x, ra_y, ra_z, rb_x, rb_y, rb_z, &mut self.row_l);
-        // Undamped, the damping branch is compiled out: in lanes a branch becomes a select,
-        // which would evaluate the damping terms' square root and divisions on every element.
-        if damping == 0.0 {
-            self.elements
-                .rows::<false>(mat, 0.0, out.0, out.1, out.2, out.3, out.4, out.5, out.6);
-        } else {
-            self.elements.rows::<true>(
-                mat, damping, out.0, out.1, out.2, out.3, out.4, out.5, out.6,
-            );
-        }
-    }
-}
-
-impl Elements {
-    /// The rows into the seven output columns. Kept out of line with each column its own
-    /// argument: the compiler then knows the outputs alias neither the inputs nor each other,
-    /// and vectorises the loop without runtime overlap checks (which it gives up on for this
-    /// many columns).
-    #[allow(clippy::too_many_arguments)]
-    #[inline(never)]
-    fn rows<const DAMPED: bool>(
-        &self,
-        mat: &Material,
-        damping: f64,
-        ra_x: &mut [f64],
-        ra_y: &mut [f64],
-        ra_z: &mut [f64],
-        rb_x: &mut [f64],
-        rb_y: &mut [f64],
-        rb_z: &mut [f64],
-        rl: &mut [f64],
-    ) {
-        let damping = if DAMPED { damping } else { 0.0 };
-        let m = rl.len();
-        // Every slice cut to its length here, so the loop carries no bounds checks.
-        let [px, py, pz, vx, vy, vz, ax, ay, az] = &self.nodes;
-        let nodes = [
-            &px[..m + 1],
-            &py[..m + 1],
-            &pz[..m + 1],
-            &vx[..m + 1],
-            &vy[..m + 1],
-            &vz[..m + 1],
-            &ax[..m + 1],
-            &ay[..m + 1],
-            &az[..m + 1],
-        ];
-        let (c1, c2, alpha, beta, gamma) = (
-            &self.c1[..m],
-            &self.c2[..m],
-            &self.alpha[..m],
-            &self.beta[..m],
-            &self.gamma[..m],
-        );
-        let (l_rate, h, inv_h, l_acceleration) = (
-            &self.l_rate[..m],
-            &self.h[..m],
-            &self.inv_h[..m],
-            &self.l_acceleration[..m],
-        );
-        let (ra_x, ra_y, ra_z) = (&mut ra_x[..m], &mut ra_y[..m], &mut ra_z[..m]);
-        let (rb_x, rb_y, rb_z) = (&mut rb_x[..m], &mut rb_y[..m], &mut rb_z[..m]);
-        for i in 0..m {
-            let at = |j: usize, q: usize| {
-                Vector3::new(nodes[3 * q][j], nodes[3 * q + 1][j], nodes[3 * q + 2][j])
-            };
-            let s = ElementState {
-                ra: at(i, 0),
-                rb: at(i + 1, 0),
-                va: at(i, 1),
-                vb: at(i + 1, 1),
-                l_rate: l_rate[i],
-                h: h[i],
-                inv_h: inv_h[i],
-                h_prime: self.h_prime,
-            };
-            let k = MassCoefficients {
-                c1: c1[i],
-                c2: c2[i],
-                alpha: alpha[i],
-                beta: beta[i],
-                gamma: gamma[i],
-            };
-            let (row_a, row_b, row_l) = element::residual_at_chord(
-                mat,
-                &k,
-                &s,
-                damping,
-                Chord::of(&s),
-                at(i, 2),
-                at(i + 1, 2),
-                l_acceleration[i],
-            );
-            ra_x[i] = row_a.x;
-            ra_y[i] = row_a.y;
-            ra_z[i] = row_a.z;
-            rb_x[i] = row_b.x;
-            rb_y[i] = row_b.y;
-            rb_z[i] = row_b.z;
-            rl[i] = row_l;
-        }
+        let m = self.l.len();
+        let input = Inputs {
+            a: std::array::from_fn(|k| &self.nodes[k][..m]),
+            b: std::array::from_fn(|k| &self.nodes[k][1..]),
+            l: &self.l,
+            l_rate: &self.l_rate,
+            l_acceleration: &self.l_acceleration,
+        };
+        self.rows.evaluate(&self.coefficients, mat, damping, &input);
     }
 }
 
@@ -217,8 +260,7 @@ impl FeSpatial {
         let (positions, velocities) = state.split_at(np);
         let sources = [positions, velocities, qdd];
         let p = self.effector_index(0);
-        let el = &mut rows.elements;
-        let len = el.h.len();
+        let len = rows.l.len();
         for cable in 0..self.robot.cables() {
             let (o, li) = (cable * (n + 1), self.l_index(cable));
             let l_acceleration = if self.length_driven {
@@ -226,14 +268,12 @@ impl FeSpatial {
             } else {
                 qdd[li]
             };
-            let h = state[li] / n as f64;
             let span = o..(o + n + 1).min(len);
-            el.h[span.clone()].fill(h);
-            el.inv_h[span.clone()].fill(1.0 / h);
-            el.l_rate[span.clone()].fill(velocities[li]);
-            el.l_acceleration[span].fill(l_acceleration);
+            rows.l[span.clone()].fill(positions[li]);
+            rows.l_rate[span.clone()].fill(velocities[li]);
+            rows.l_acceleration[span].fill(l_acceleration);
             // The arm's columns cut once (a store through a column then cannot move another).
-            let columns = el.nodes.each_mut().map(|c| &mut c[o..o + n + 1]);
+            let columns = rows.nodes.each_mut().map(|c| &mut c[o..o + n + 1]);
             let pulley = self.pulley(cable);
             for axis in 0..3 {
                 columns[axis][0] = pulley[axis];
@@ -281,20 +321,20 @@ impl FeSpatial {
             let nodes = &mut r[free..free + 3 * (n - 1)];
             for axis in 0..3 {
                 let (b, a) = (
-                    &rows.row_b[axis][o..o + n - 1],
-                    &rows.row_a[axis][o + 1..o + n],
+                    &rows.rows.b[axis][o..o + n - 1],
+                    &rows.rows.a[axis][o + 1..o + n],
                 );
                 for ((node, b), a) in nodes.chunks_exact_mut(3).zip(b).zip(a) {
                     node[axis] = b + a;
                 }
             }
-            r_p += row(&rows.row_b, o + n - 1);
+            r_p += row(&rows.rows.b, o + n - 1);
             let (li, rho) = (self.l_index(cable), self.l_index(cable) + 1);
             if self.length_driven {
-                r[li] = qdd[li] - rows.elements.l_acceleration[o];
+                r[li] = qdd[li] - rows.l_acceleration[o];
                 r[rho] = qdd[rho];
             } else {
-                let span: f64 = rows.row_l[o..o + n].iter().sum();
+                let span: f64 = rows.rows.l[o..o + n].iter().sum();
                 let (reel_row, l_row) = self.stored_rows(state, qdd, cable);
                 r[li] = span + l_row;
                 r[rho] = reel_row - tension;
@@ -349,24 +389,22 @@ mod tests {
             // Values spread from the seed; consecutive nodes about 0.1 m apart, so every
             // element is taut or slack by the draw.
             let value = |j: usize, k: usize| seed[(7 * j + 3 * k) % seed.len()] * (1.0 + 0.01 * k as f64);
-            let el = &mut rows.elements;
             for j in 0..arms * (n + 1) {
                 for k in 0..9 {
-                    el.nodes[k][j] = if k < 3 { 0.1 * j as f64 + 0.05 * value(j, k) } else { value(j, k) };
+                    rows.nodes[k][j] = if k < 3 { 0.1 * j as f64 + 0.05 * value(j, k) } else { value(j, k) };
                 }
             }
             for a in 0..arms {
                 let l = 0.5 + 0.1 * seed[a % seed.len()];
                 for e in 1..=n {
                     let i = a * (n + 1) + e - 1;
-                    el.h[i] = l / n as f64;
-                    el.inv_h[i] = 1.0 / el.h[i];
-                    el.l_rate[i] = seed[(a + 5) % seed.len()];
-                    el.l_acceleration[i] = seed[(a + 11) % seed.len()];
+                    rows.l[i] = l;
+                    rows.l_rate[i] = seed[(a + 5) % seed.len()];
+                    rows.l_acceleration[i] = seed[(a + 11) % seed.len()];
                 }
             }
             rows.evaluate(&mat, damping);
-            let el = &rows.elements;
+            let el = &rows;
             let node = |q: usize, j: usize| Vector3::new(el.nodes[3 * q][j], el.nodes[3 * q + 1][j], el.nodes[3 * q + 2][j]);
             let same = |u: Vector3<f64>, v: [f64; 3]| (0..3).all(|k| u[k].to_bits() == v[k].to_bits());
             for a in 0..arms {
@@ -376,7 +414,7 @@ mod tests {
                         (node(0, i), node(1, i)),
                         (node(0, i + 1), node(1, i + 1)),
                         el.l_rate[i],
-                        el.h[i],
+                        el.l[i] / n as f64,
                         1.0 / n as f64,
                     );
                     let (ra, rb, rl) = element::residual_at_chord(
@@ -384,8 +422,8 @@ mod tests {
                         node(2, i), node(2, i + 1), el.l_acceleration[i],
                     );
                     let at = |r: &[Vec<f64>; 3]| [r[0][i], r[1][i], r[2][i]];
-                    prop_assert!(same(ra, at(&rows.row_a)) && same(rb, at(&rows.row_b)), "arm {a} element {e}");
-                    prop_assert_eq!(rl.to_bits(), rows.row_l[i].to_bits(), "arm {} element {}", a, e);
+                    prop_assert!(same(ra, at(&rows.rows.a)) && same(rb, at(&rows.rows.b)), "arm {a} element {e}");
+                    prop_assert_eq!(rl.to_bits(), rows.rows.l[i].to_bits(), "arm {} element {}", a, e);
                 }
             }
         }

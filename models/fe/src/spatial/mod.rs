@@ -10,6 +10,7 @@
 //! reels driven by length prescribe l_i ([`prescribed`]). The stored cable is elastic (FE.1.3's
 //! reference variant); the rigid variant is planar only.
 
+mod block_lanes;
 mod blocks;
 mod implicit;
 mod lanes;
@@ -53,6 +54,8 @@ pub struct FeSpatial {
     /// Where the element blocks' entries go in the iteration pattern (built at the first
     /// element-by-element matrix, [`blocks`]).
     block_slots: Vec<usize>,
+    /// The free elements' blocks in lanes ([`block_lanes`]; built at the first matrix).
+    block_lanes: block_lanes::BlockLanes,
     /// Where Du's form rewrites them, and its scratch ([`blocks::DrivenSlots`]).
     driven_slots: blocks::DrivenSlots,
     /// Reels driven by length (the scenario's `length` controller): the free lengths l_i are
@@ -148,6 +151,7 @@ impl FeSpatial {
             border_accelerations: vec![[0.0; 2]; m],
             differences: None,
             block_slots: Vec::new(),
+            block_lanes: block_lanes::BlockLanes::default(),
             driven_slots: blocks::DrivenSlots::default(),
             length_driven: false,
             drive: None,
