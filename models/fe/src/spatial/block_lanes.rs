@@ -10,7 +10,7 @@
 //! is the iteration matrix's largest cost, and the kernel's vector width sits idle.
 
 use super::FeSpatial;
-use super::lanes::{Coefficients, Inputs, Rows};
+use super::lanes::{Coefficients, Inputs, Length, Rows};
 use cdpr_numerics::differences::central_step;
 
 /// A block's weighted derivative matrix, local[row][col].
@@ -50,9 +50,9 @@ impl BlockLanes {
     fn new(model: &FeSpatial) -> Self {
         let (m, n) = (model.robot.cables(), model.elements);
         let len = m * n;
-        let per_element = (0..len).map(|i| &model.coefficients[i % n]);
+        let per_element = (0..len).map(|i| (&model.coefficients[i % n], Length::Free(n)));
         Self {
-            coefficients: Coefficients::new(n, per_element),
+            coefficients: Coefficients::new(per_element),
             base: vec![vec![0.0; len]; COLUMNS],
             limit: vec![0.0; len],
             up: vec![0.0; len],
@@ -105,20 +105,20 @@ impl FeSpatial {
                 let c = column(which, col);
                 let x = &lanes.base[c];
                 let central = which != 2;
-                for i in 0..x.len() {
+                for (i, &x) in x.iter().enumerate() {
                     if central {
                         let limit = if which == 0 {
                             lanes.limit[i]
                         } else {
                             f64::INFINITY
                         };
-                        let step = central_step(x[i], limit);
-                        lanes.up[i] = x[i] + step;
-                        lanes.down[i] = x[i] - step;
+                        let step = central_step(x, limit);
+                        lanes.up[i] = x + step;
+                        lanes.down[i] = x - step;
                         lanes.width[i] = lanes.up[i] - lanes.down[i];
                     } else {
-                        lanes.up[i] = x[i] + x[i].abs().max(1.0);
-                        lanes.width[i] = lanes.up[i] - x[i];
+                        lanes.up[i] = x + x.abs().max(1.0);
+                        lanes.width[i] = lanes.up[i] - x;
                     }
                 }
                 let up = BlockLanes::inputs(&lanes.base, Some((c, &lanes.up)));

@@ -19,7 +19,17 @@ use super::FeSpatial;
 use crate::element::{self, Chord, ElementState, MassCoefficients, Material};
 use nalgebra::Vector3;
 
-/// The span elements' fixed mass coefficients, element by element, and N.
+/// How an element's unstrained length h follows its cable's free length l.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Length {
+    /// One of the span's N elements: h = l/N, h' = 1/N.
+    Free(usize),
+    /// The stored element of a cable of total unstrained length L0 [m]: h = L0 − l, h' = −1.
+    Stored(f64),
+}
+
+/// The elements' fixed mass coefficients and how each one's h follows l, element by element:
+/// h = (offset + slope l)/divisor, which is l/N or L0 − l to the bit.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub(super) struct Coefficients {
     c1: Vec<f64>,
@@ -27,25 +37,30 @@ pub(super) struct Coefficients {
     alpha: Vec<f64>,
     beta: Vec<f64>,
     gamma: Vec<f64>,
-    /// Elements per span N, and h' = 1/N.
-    n: f64,
-    h_prime: f64,
+    offset: Vec<f64>,
+    slope: Vec<f64>,
+    divisor: Vec<f64>,
+    h_prime: Vec<f64>,
 }
 
 impl Coefficients {
-    /// Element i's coefficients `per_element[i]`, for spans of N = `n` elements.
-    pub fn new<'a>(n: usize, per_element: impl Iterator<Item = &'a MassCoefficients>) -> Self {
-        let mut k = Self {
-            n: n as f64,
-            h_prime: 1.0 / n as f64,
-            ..Self::default()
-        };
-        for c in per_element {
+    /// Element i's mass coefficients and length, the i-th of `per_element`.
+    pub fn new<'a>(per_element: impl Iterator<Item = (&'a MassCoefficients, Length)>) -> Self {
+        let mut k = Self::default();
+        for (c, length) in per_element {
             k.c1.push(c.c1);
             k.c2.push(c.c2);
             k.alpha.push(c.alpha);
             k.beta.push(c.beta);
             k.gamma.push(c.gamma);
+            let (offset, slope, divisor, h_prime) = match length {
+                Length::Free(n) => (0.0, 1.0, n as f64, 1.0 / n as f64),
+                Length::Stored(total) => (total, -1.0, 1.0, -1.0),
+            };
+            k.offset.push(offset);
+            k.slope.push(slope);
+            k.divisor.push(divisor);
+            k.h_prime.push(h_prime);
         }
         k
     }
@@ -138,6 +153,12 @@ fn rows<const DAMPED: bool>(
         &k.beta[..m],
         &k.gamma[..m],
     );
+    let (offset, slope, divisor, h_prime) = (
+        &k.offset[..m],
+        &k.slope[..m],
+        &k.divisor[..m],
+        &k.h_prime[..m],
+    );
     let (l, l_rate, l_acceleration) = (
         &input.l[..m],
         &input.l_rate[..m],
@@ -149,7 +170,7 @@ fn rows<const DAMPED: bool>(
         let at =
             |c: &[&[f64]; 9], q: usize| Vector3::new(c[3 * q][i], c[3 * q + 1][i], c[3 * q + 2][i]);
         // h and 1/h as `ElementState::new` forms them.
-        let h = l[i] / k.n;
+        let h = (offset[i] + slope[i] * l[i]) / divisor[i];
         let s = ElementState {
             ra: at(&a, 0),
             rb: at(&b, 0),
@@ -158,7 +179,7 @@ fn rows<const DAMPED: bool>(
             l_rate: l_rate[i],
             h,
             inv_h: 1.0 / h,
-            h_prime: k.h_prime,
+            h_prime: h_prime[i],
         };
         let coefficients = MassCoefficients {
             c1: c1[i],
@@ -187,14 +208,20 @@ fn rows<const DAMPED: bool>(
     }
 }
 
-/// The residual's span elements, arm after arm: an arm's element e at index a (N + 1) + e − 1,
-/// its nodes at that index and the next (allocated once).
+/// The residual's elements: each arm's span elements, arm after arm, then each cable's stored
+/// element. Nodes in columns: per arm its pulley, free nodes and the effector (N + 1), so arm
+/// a's element e is the pair at index a (N + 1) + e − 1; then per cable its reel end R_i and
+/// pulley A_i, the stored element the pair at m (N + 1) + 2i. The pairs between (an arm's
+/// effector and the next pulley, a pulley and the next reel end) are computed and never read.
+/// Allocated once.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub(super) struct StarRows {
     coefficients: Coefficients,
-    /// The nodes' positions, velocities and accelerations (x, y, z each), N + 1 per arm.
+    /// Elements per span N.
+    elements: usize,
+    /// The nodes' positions, velocities and accelerations (x, y, z each).
     nodes: [Vec<f64>; 9],
-    /// Per element, its span's l [m], l' [m/s] and l'' [m/s²].
+    /// Per element, its cable's l [m], l' [m/s] and l'' [m/s²].
     l: Vec<f64>,
     l_rate: Vec<f64>,
     l_acceleration: Vec<f64>,
@@ -202,15 +229,28 @@ pub(super) struct StarRows {
 }
 
 impl StarRows {
-    /// For `arms` ≥ 1 arms of N elements with the coefficients of elements e = 1 … N
-    /// (index e − 1).
-    pub fn new(arms: usize, coefficients: &[MassCoefficients]) -> Self {
+    /// For `arms` ≥ 1 cables of N elements with the coefficients of elements e = 1 … N (index
+    /// e − 1), and their stored elements' coefficients and total unstrained length [m].
+    pub fn new(
+        arms: usize,
+        coefficients: &[MassCoefficients],
+        stored: &MassCoefficients,
+        total_length: f64,
+    ) -> Self {
         let n = coefficients.len();
-        let len = arms * (n + 1) - 1;
-        // The joining pairs take the last element's coefficients: any finite numbers do.
-        let per_element = (0..len).map(|i| &coefficients[(i % (n + 1)).min(n - 1)]);
+        let spans = arms * (n + 1);
+        let len = spans + 2 * arms - 1;
+        // The joining pairs take a neighbour's coefficients: any finite numbers do.
+        let per_element = (0..len).map(|i| {
+            if i < spans {
+                (&coefficients[(i % (n + 1)).min(n - 1)], Length::Free(n))
+            } else {
+                (stored, Length::Stored(total_length))
+            }
+        });
         Self {
-            coefficients: Coefficients::new(n, per_element),
+            coefficients: Coefficients::new(per_element),
+            elements: n,
             nodes: std::array::from_fn(|_| vec![0.0; len + 1]),
             l: vec![1.0; len],
             l_rate: vec![0.0; len],
@@ -219,7 +259,13 @@ impl StarRows {
         }
     }
 
-    /// The rows of every span element from the nodes and spans set.
+    /// Index of cable `cable`'s stored element (its reel end's node).
+    fn stored(&self, cable: usize) -> usize {
+        let arms = (self.l.len() + 1) / (self.elements + 3);
+        arms * (self.elements + 1) + 2 * cable
+    }
+
+    /// The rows of every element from the nodes and spans set.
     pub fn evaluate(&mut self, mat: &Material, damping: f64) {
         let m = self.l.len();
         let input = Inputs {
@@ -250,17 +296,17 @@ impl FeSpatial {
         let mut rows = std::mem::take(&mut self.rows);
         self.gather_rows(&mut rows, state, qdd);
         rows.evaluate(&self.material, self.axial_damping);
-        self.sum_rows(&rows, state, qdd, tensions, r);
+        self.sum_rows(&rows, qdd, tensions, r);
         self.rows = rows;
     }
 
-    /// Each arm's nodes (its pulley at rest, its free nodes, the effector) and span into `rows`.
+    /// Each arm's nodes (its pulley at rest, its free nodes, the effector) and span, and each
+    /// stored element's nodes (R_i = A_i + ρ_i r_i moving along r_i, A_i at rest) into `rows`.
     fn gather_rows(&self, rows: &mut StarRows, state: &[f64], qdd: &[f64]) {
         let (n, np) = (self.elements, self.positions_len());
         let (positions, velocities) = state.split_at(np);
         let sources = [positions, velocities, qdd];
         let p = self.effector_index(0);
-        let len = rows.l.len();
         for cable in 0..self.robot.cables() {
             let (o, li) = (cable * (n + 1), self.l_index(cable));
             let l_acceleration = if self.length_driven {
@@ -268,10 +314,9 @@ impl FeSpatial {
             } else {
                 qdd[li]
             };
-            let span = o..(o + n + 1).min(len);
-            rows.l[span.clone()].fill(positions[li]);
-            rows.l_rate[span.clone()].fill(velocities[li]);
-            rows.l_acceleration[span].fill(l_acceleration);
+            rows.l[o..o + n + 1].fill(positions[li]);
+            rows.l_rate[o..o + n + 1].fill(velocities[li]);
+            rows.l_acceleration[o..o + n + 1].fill(l_acceleration);
             // The arm's columns cut once (a store through a column then cannot move another).
             let columns = rows.nodes.each_mut().map(|c| &mut c[o..o + n + 1]);
             let pulley = self.pulley(cable);
@@ -295,18 +340,34 @@ impl FeSpatial {
                     columns[3 * q + axis][n] = source[p + axis];
                 }
             }
+            self.gather_stored(rows, cable, state, qdd);
+        }
+    }
+
+    /// Cable `cable`'s stored element into `rows`, as [`FeSpatial::stored_element`] has it.
+    fn gather_stored(&self, rows: &mut StarRows, cable: usize, state: &[f64], qdd: &[f64]) {
+        let (np, li) = (self.positions_len(), self.l_index(cable));
+        let s = rows.stored(cable);
+        let joint = (s + 2).min(rows.l.len());
+        rows.l[s..joint].fill(state[li]);
+        rows.l_rate[s..joint].fill(state[np + li]);
+        rows.l_acceleration[s..joint].fill(qdd[li]);
+        let (pulley, reel) = (self.pulley(cable), self.reels[cable]);
+        let reel_end = [
+            pulley + reel * state[li + 1],
+            reel * state[np + li + 1],
+            reel * qdd[li + 1],
+        ];
+        for (q, at) in reel_end.iter().enumerate() {
+            for axis in 0..3 {
+                rows.nodes[3 * q + axis][s] = at[axis];
+                rows.nodes[3 * q + axis][s + 1] = if q == 0 { pulley[axis] } else { 0.0 };
+            }
         }
     }
 
     /// R from the evaluated element rows (see [`Self::element_residual`]).
-    fn sum_rows(
-        &self,
-        rows: &StarRows,
-        state: &[f64],
-        qdd: &[f64],
-        tensions: &[f64],
-        r: &mut [f64],
-    ) {
+    fn sum_rows(&self, rows: &StarRows, qdd: &[f64], tensions: &[f64], r: &mut [f64]) {
         let n = self.elements;
         let p = self.effector_index(0);
         let row = |columns: &[Vec<f64>; 3], i: usize| {
@@ -334,31 +395,14 @@ impl FeSpatial {
                 r[li] = qdd[li] - rows.l_acceleration[o];
                 r[rho] = qdd[rho];
             } else {
+                // The stored element: its l row, and its reel end's rows along r_i.
+                let s = rows.stored(cable);
                 let span: f64 = rows.rows.l[o..o + n].iter().sum();
-                let (reel_row, l_row) = self.stored_rows(state, qdd, cable);
-                r[li] = span + l_row;
-                r[rho] = reel_row - tension;
+                r[li] = span + rows.rows.l[s];
+                r[rho] = row(&rows.rows.a, s).dot(&self.reels[cable]) - tension;
             }
         }
         r[p..p + 3].copy_from_slice(r_p.as_slice());
-    }
-
-    /// The stored element's rows of `cable`: along r_i at its reel end (R = A + ρ r, a_R =
-    /// ρ'' r), and l [N] (h' = −1).
-    fn stored_rows(&self, state: &[f64], qdd: &[f64], cable: usize) -> (f64, f64) {
-        let (li, reel) = (self.l_index(cable), self.reels[cable]);
-        let s = self.stored_element(state, cable);
-        let (r_reel, _, r_l) = element::residual_at_chord(
-            &self.material,
-            &self.stored_coefficients,
-            &s,
-            self.axial_damping,
-            Chord::of(&s),
-            reel * qdd[li + 1],
-            Vector3::zeros(),
-            qdd[li],
-        );
-        (r_reel.dot(&reel), r_l)
     }
 }
 
@@ -369,9 +413,10 @@ mod tests {
     use proptest::prelude::*;
 
     proptest! {
-        /// Every lane's rows are the scalar element kernel's bit for bit, for each element of
-        /// 1 … 8 arms of N = 1 … 12 elements (lengths that leave a partial vector), nodes, spans
-        /// and accelerations random, with and without damping, lumped and consistent mass.
+        /// Every lane's rows are the scalar element kernel's bit for bit, for each span element
+        /// of 1 … 8 arms of N = 1 … 12 elements (lengths that leave a partial vector) and each
+        /// stored element (h = L0 − l, h' = −1), nodes, lengths, rates and accelerations
+        /// random, with and without damping, lumped and consistent mass.
         #[test]
         fn lanes_are_the_scalar_kernel_bit_for_bit(
             arms in 1usize..9,
@@ -384,47 +429,49 @@ mod tests {
             let w = |k: usize| 1.0 - k as f64 / n as f64;
             let coefficients: Vec<_> =
                 (1..=n).map(|e| MassCoefficients::new(mass, w(e - 1), w(e))).collect();
+            let stored = MassCoefficients::new(mass, 0.0, 1.0);
+            let total = 3.0;
             let mat = Material { ea: 1.0e4, mu: 0.05, gravity: 9.81 };
-            let mut rows = StarRows::new(arms, &coefficients);
+            let mut rows = StarRows::new(arms, &coefficients, &stored, total);
             // Values spread from the seed; consecutive nodes about 0.1 m apart, so every
             // element is taut or slack by the draw.
             let value = |j: usize, k: usize| seed[(7 * j + 3 * k) % seed.len()] * (1.0 + 0.01 * k as f64);
-            for j in 0..arms * (n + 1) {
+            let len = rows.l.len();
+            for j in 0..=len {
                 for k in 0..9 {
                     rows.nodes[k][j] = if k < 3 { 0.1 * j as f64 + 0.05 * value(j, k) } else { value(j, k) };
                 }
             }
-            for a in 0..arms {
-                let l = 0.5 + 0.1 * seed[a % seed.len()];
-                for e in 1..=n {
-                    let i = a * (n + 1) + e - 1;
-                    rows.l[i] = l;
-                    rows.l_rate[i] = seed[(a + 5) % seed.len()];
-                    rows.l_acceleration[i] = seed[(a + 11) % seed.len()];
-                }
+            for i in 0..len {
+                rows.l[i] = 0.5 + 0.1 * value(i, 1);
+                rows.l_rate[i] = value(i, 5);
+                rows.l_acceleration[i] = value(i, 11);
             }
             rows.evaluate(&mat, damping);
             let el = &rows;
             let node = |q: usize, j: usize| Vector3::new(el.nodes[3 * q][j], el.nodes[3 * q + 1][j], el.nodes[3 * q + 2][j]);
             let same = |u: Vector3<f64>, v: [f64; 3]| (0..3).all(|k| u[k].to_bits() == v[k].to_bits());
-            for a in 0..arms {
-                for e in 1..=n {
-                    let i = a * (n + 1) + e - 1;
-                    let s = ElementState::new(
-                        (node(0, i), node(1, i)),
-                        (node(0, i + 1), node(1, i + 1)),
-                        el.l_rate[i],
-                        el.l[i] / n as f64,
-                        1.0 / n as f64,
-                    );
-                    let (ra, rb, rl) = element::residual_at_chord(
-                        &mat, &coefficients[e - 1], &s, damping, Chord::of(&s),
-                        node(2, i), node(2, i + 1), el.l_acceleration[i],
-                    );
-                    let at = |r: &[Vec<f64>; 3]| [r[0][i], r[1][i], r[2][i]];
-                    prop_assert!(same(ra, at(&rows.rows.a)) && same(rb, at(&rows.rows.b)), "arm {a} element {e}");
-                    prop_assert_eq!(rl.to_bits(), rows.rows.l[i].to_bits(), "arm {} element {}", a, e);
-                }
+            let elements = (0..arms).flat_map(|a| (1..=n).map(move |e| (a * (n + 1) + e - 1, Some(e))));
+            let stored_elements = (0..arms).map(|a| (el.stored(a), None));
+            for (i, e) in elements.chain(stored_elements) {
+                let (h, h_prime, k) = match e {
+                    Some(e) => (el.l[i] / n as f64, 1.0 / n as f64, &coefficients[e - 1]),
+                    None => (total - el.l[i], -1.0, &stored),
+                };
+                let s = ElementState::new(
+                    (node(0, i), node(1, i)),
+                    (node(0, i + 1), node(1, i + 1)),
+                    el.l_rate[i],
+                    h,
+                    h_prime,
+                );
+                let (ra, rb, rl) = element::residual_at_chord(
+                    &mat, k, &s, damping, Chord::of(&s),
+                    node(2, i), node(2, i + 1), el.l_acceleration[i],
+                );
+                let at = |r: &[Vec<f64>; 3]| [r[0][i], r[1][i], r[2][i]];
+                prop_assert!(same(ra, at(&el.rows.a)) && same(rb, at(&el.rows.b)), "element {i} ({e:?})");
+                prop_assert_eq!(rl.to_bits(), el.rows.l[i].to_bits(), "element {} ({:?})", i, e);
             }
         }
     }

@@ -136,6 +136,7 @@ impl FeSpatial {
         let coefficients: Vec<MassCoefficients> = (1..=n)
             .map(|e| MassCoefficients::new(mass, w(e - 1), w(e)))
             .collect();
+        let stored = MassCoefficients::new(mass, 0.0, 1.0);
         Self {
             robot,
             elements: n,
@@ -143,9 +144,9 @@ impl FeSpatial {
             material,
             axial_damping,
             reels,
-            rows: lanes::StarRows::new(m, &coefficients),
+            rows: lanes::StarRows::new(m, &coefficients, &stored, modelled_length),
             coefficients,
-            stored_coefficients: MassCoefficients::new(mass, 0.0, 1.0),
+            stored_coefficients: stored,
             system: StarSystem::new(m, n - 1),
             node_accelerations: vec![Vector3::zeros(); m * (n - 1)],
             border_accelerations: vec![[0.0; 2]; m],
