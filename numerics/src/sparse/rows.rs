@@ -70,6 +70,23 @@ impl Rows {
         self.order.clear();
         self.order.extend(0..n);
         self.order.sort_by_key(|&i| (level[i], i));
+        // The rows stored in that order, so the sweep reads its entries front to back.
+        let mut ptr = Vec::with_capacity(n + 1);
+        ptr.push(0);
+        let mut col = Vec::with_capacity(self.col.len());
+        let mut moved = vec![0usize; self.col.len()];
+        for &i in &self.order {
+            let row = self.ptr[i]..self.ptr[i + 1];
+            for (to, &c) in moved[row.clone()].iter_mut().zip(&self.col[row]) {
+                *to = col.len();
+                col.push(c);
+            }
+            ptr.push(col.len());
+        }
+        for s in &mut self.slot {
+            *s = moved[*s];
+        }
+        (self.ptr, self.col) = (ptr, col);
     }
 
     /// The values of the factor's compressed columns, moved to their rows.
@@ -79,10 +96,11 @@ impl Rows {
         }
     }
 
-    /// Row i's Σ-free update: `x_i` less each entry times its (final) unknown, in order.
+    /// The update of the row at place k of the sweep: `x_i` less each entry times its (final)
+    /// unknown, in order.
     #[inline(always)]
-    fn reduce(&self, i: usize, x: &[f64], mut xi: f64) -> f64 {
-        let (start, end) = (self.ptr[i], self.ptr[i + 1]);
+    fn reduce(&self, k: usize, x: &[f64], mut xi: f64) -> f64 {
+        let (start, end) = (self.ptr[k], self.ptr[k + 1]);
         for (&c, &v) in self.col[start..end].iter().zip(&self.val[start..end]) {
             xi -= v * x[c];
         }
@@ -116,11 +134,11 @@ impl RowSweeps {
 
     /// x ← U⁻¹ L⁻¹ x, L with a unit diagonal, U's diagonal given inverted.
     pub(super) fn solve(&self, x: &mut [f64], u_inv_diag: &[f64]) {
-        for &i in &self.lower.order {
-            x[i] = self.lower.reduce(i, x, x[i]);
+        for (k, &i) in self.lower.order.iter().enumerate() {
+            x[i] = self.lower.reduce(k, x, x[i]);
         }
-        for &i in &self.upper.order {
-            x[i] = self.upper.reduce(i, x, x[i]) * u_inv_diag[i];
+        for (k, &i) in self.upper.order.iter().enumerate() {
+            x[i] = self.upper.reduce(k, x, x[i]) * u_inv_diag[i];
         }
     }
 }
