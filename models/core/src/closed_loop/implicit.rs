@@ -9,6 +9,7 @@ use crate::controller::{self, Controller, Reference};
 use crate::model::CableModel;
 use crate::robot::{Effector, MAX_AXES, Tensions};
 use cdpr_numerics::{MatrixCost, SecondOrderSystem};
+use std::cell::Cell;
 
 /// What an implicit step needs from its start (t_n, y_n) besides the integrator's own state.
 #[derive(Debug, Clone, Default)]
@@ -35,6 +36,18 @@ pub(super) struct StepStart<const D: usize> {
     /// evaluation (the right-hand side, which a restart calls) forgets them.
     pub(super) audited_at: Option<f64>,
     audited: (f64, f64),
+    /// The last reference the implicit path asked for, and its time: a step's start, its
+    /// Newton iterations, its matrix's tension columns, its end and the next step's start ask
+    /// at two times, and a print's reference convolves the plan with the shapers. Forgotten
+    /// when a run starts ([`StepStart::forget_reference`]), which may move the hold.
+    remembered: Cell<Option<(f64, Reference<D>)>>,
+}
+
+impl<const D: usize> StepStart<D> {
+    /// Forgets the remembered reference (a run's start: the hold and the path are set there).
+    pub(super) fn forget_reference(&self) {
+        self.remembered.set(None);
+    }
 }
 
 impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
@@ -60,6 +73,19 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         }
     }
 
+    /// [`ClosedLoop::reference`] at t, remembered from the last call at t (see
+    /// [`StepStart::remembered`]).
+    fn step_reference(&self, t: f64) -> Reference<D> {
+        if let Some((at, reference)) = self.step_start.remembered.get()
+            && at == t
+        {
+            return reference;
+        }
+        let reference = self.reference(t);
+        self.step_start.remembered.set(Some((t, reference)));
+        reference
+    }
+
     /// The command at the end t of the current implicit step for the effector state `effector`,
     /// and the controller states advanced there from the step's start (into `states`).
     fn step_end_command(
@@ -70,7 +96,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
     ) -> Command {
         let s = &self.step_start;
         let c = self.controller_len();
-        let reference = self.reference(t);
+        let reference = self.step_reference(t);
         let start = controller::StepStart {
             reference: s.reference,
             effector: s.effector,
@@ -170,7 +196,7 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         let c = self.controller_len();
         let model_state = &y[..n];
         let effector = self.model.effector(model_state);
-        let reference = self.reference(t);
+        let reference = self.step_reference(t);
         let cmd = self.command_with(t, &reference, &effector, &y[n..n + c]);
         let (power, dissipation) = self.audits_at(t, model_state, &cmd);
         let s = &mut self.step_start;
@@ -256,7 +282,7 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         let n = self.model_len();
         let c = self.controller_len();
         let effector = self.model.effector(&y[..n]);
-        let reference = self.reference(t);
+        let reference = self.step_reference(t);
         let cmd = self.command_with(t, &reference, &effector, &y[n..n + c]);
         let audits = self.audits_at(t, &y[..n], &cmd);
         self.controller_and_audit_rates(y, (&reference, &effector), cmd.saturated, audits, out);

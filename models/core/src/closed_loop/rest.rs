@@ -39,6 +39,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
     /// holding the equilibrium's tensions (the paper's PID: w(0) = F0/I, f(0) = e(0) = 0), audits
     /// zero. The equilibrium's position becomes the held start of the reference.
     pub fn initial_state(&mut self) -> Result<(Vec<f64>, Equilibrium), LoopError> {
+        self.step_start.forget_reference();
         if let Some(path) = self.path.clone() {
             return self.start_of_path(&path);
         }
