@@ -39,7 +39,8 @@ pub(super) struct StepStart<const D: usize> {
     /// The last reference the implicit path asked for, and its time: a step's start, its
     /// Newton iterations, its matrix's tension columns, its end and the next step's start ask
     /// at two times, and a print's reference convolves the plan with the shapers. Forgotten
-    /// when a run starts ([`StepStart::forget_reference`]), which may move the hold.
+    /// ([`ClosedLoop::forget_reference`]) when a run starts (the runner; the path, the shaper
+    /// or the trajectory may have been replaced since the last run) and when the hold moves.
     remembered: Cell<Option<(f64, Reference<D>)>>,
 }
 
@@ -71,6 +72,11 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         if self.drives_reels_by_length() && self.step_start.driven_at != Some(t) {
             self.drive_reels(t);
         }
+    }
+
+    /// Forgets the implicit path's remembered reference ([`StepStart::remembered`]).
+    pub(crate) fn forget_reference(&self) {
+        self.step_start.forget_reference();
     }
 
     /// [`ClosedLoop::reference`] at t, remembered from the last call at t (see

@@ -39,7 +39,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
     /// holding the equilibrium's tensions (the paper's PID: w(0) = F0/I, f(0) = e(0) = 0), audits
     /// zero. The equilibrium's position becomes the held start of the reference.
     pub fn initial_state(&mut self) -> Result<(Vec<f64>, Equilibrium), LoopError> {
-        self.step_start.forget_reference();
+        self.forget_reference();
         if let Some(path) = self.path.clone() {
             return self.start_of_path(&path);
         }
@@ -58,6 +58,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         let mut hold = self.hold.unwrap_or_else(crate::robot::Vector::zeros);
         hold[vertical::<D>()] = z0;
         self.hold = Some(hold);
+        self.forget_reference();
         self.controller.hold_height(z0)?;
         Ok(())
     }

@@ -274,6 +274,7 @@ fn integrate_and_sample<M: CableModel<D>, const D: usize>(
     observer: &mut Observer,
 ) -> Result<Run, Box<RunFailure>> {
     let start = Instant::now();
+    sys.forget_reference();
     let mut sampler = Sampler::new(sys, &y0, opts, buffer);
     let mut events = Vec::new();
     let mut dopri;

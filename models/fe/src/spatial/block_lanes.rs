@@ -6,7 +6,7 @@
 //! differences are the scalar [`FeSpatial::local_matrix`]'s, in its order, so every block is
 //! its matrix bit for bit (a test below checks it).
 //!
-//! Why: a matrix differences its ~4m N free elements 36 times each; one element at a time that
+//! Why: a matrix differences its m N free elements 36 times each; one element at a time that
 //! is the iteration matrix's largest cost, and the kernel's vector width sits idle.
 
 use super::FeSpatial;

@@ -2,9 +2,11 @@
 //! element, as the planar model's (`crate::implicit`): R sums additive blocks — each free
 //! element in its 7 local unknowns (r_a, r_b, l_i; r_a fixed at the pulley for e = 1), each
 //! stored element in (ρ_i, l_i), the effector's own mass and weight in its 3 — so differencing
-//! the element kernel ([`element::residual_at_chord`], the one the star's assembly is checked
-//! against, axial damping included) in its local unknowns and adding the blocks gives the
-//! global S at O(m N) kernel calls. Coloured differences of the whole residual need one
+//! the element kernel ([`element::residual_at_chord`], the one R is summed from, axial damping
+//! included) in its local unknowns and adding the blocks gives the global S at O(m N) kernel
+//! calls. The free elements' blocks are differenced all at once in lanes
+//! ([`super::block_lanes`]); the scalar [`FeSpatial::local_matrix`] differences the stored
+//! elements' and the effector's, and is the lanes' reference in their test. Coloured differences of the whole residual need one
 //! assembly per colour and, the l_i columns being dense in their span, far more colours (242
 //! residual sweeps per matrix at N = 10 with damping, against ~36 sweeps' worth of kernels
 //! here). The commanded tensions enter R linearly and drop out.

@@ -1,7 +1,8 @@
 //! The spatial FE robot's second-order form R = M(q) q'' − F(q, q', T) for the implicit path
-//! (MODELS.md FE.9.3): R from the star's assembly ([`super::star::StarSystem::residual`]), the
-//! iteration matrix element by element ([`super::blocks`]; the tests' reference: coloured
-//! central differences of R over the star's pattern, [`ColouredDifferences`]), each position
+//! (MODELS.md FE.9.3): R summed from the element rows in lanes ([`super::lanes`]; the tests'
+//! reference: R vanishing at the star solve's q'' = M⁻¹F), the iteration matrix element by
+//! element ([`super::blocks`], [`super::block_lanes`]; the tests' reference: coloured central
+//! differences of R over the star's pattern, [`ColouredDifferences`]), each position
 //! step kept within a quarter of the stretch of the elements it moves so that no
 //! probe reaches the tension-only kink.
 
@@ -114,7 +115,7 @@ impl SecondOrderForm for FeSpatial {
         }
     }
 
-    /// Driven by length, the assembly's l_i rows read l_i'' = the command (Du's form).
+    /// Driven by length, the residual's l_i rows read l_i'' = the command (Du's form).
     fn follows_driven_reels(&self) -> bool {
         true
     }

@@ -4,8 +4,9 @@
 //!
 //! Every arm's nodes are laid out arm after arm in columns — its pulley at rest, its free nodes
 //! 1 … N − 1, the effector — so an arm's element e is the consecutive pair (e − 1, e) and one
-//! loop over all consecutive pairs runs [`element::residual_at_chord`] on every lane (the m − 1
-//! pairs that join an arm's effector to the next arm's pulley are computed and never read).
+//! loop over all consecutive pairs runs [`element::residual_at_chord`] on every lane; each
+//! cable's stored element follows as the pair (R_i, A_i) (the 2m − 1 pairs between are computed
+//! and never read).
 //! Each lane does the scalar kernel's operations in its order, so the rows are the scalar
 //! kernel's bit for bit (a test below checks it). The rows are then summed into R per node, per
 //! l_i and at the effector, with each stored element's rows (one per cable, scalar) and the
@@ -217,7 +218,8 @@ fn rows<const DAMPED: bool>(
 #[derive(Debug, Clone, PartialEq, Default)]
 pub(super) struct StarRows {
     coefficients: Coefficients,
-    /// Elements per span N.
+    /// Cables m and elements per span N.
+    arms: usize,
     elements: usize,
     /// The nodes' positions, velocities and accelerations (x, y, z each).
     nodes: [Vec<f64>; 9],
@@ -250,6 +252,7 @@ impl StarRows {
         });
         Self {
             coefficients: Coefficients::new(per_element),
+            arms,
             elements: n,
             nodes: std::array::from_fn(|_| vec![0.0; len + 1]),
             l: vec![1.0; len],
@@ -261,8 +264,7 @@ impl StarRows {
 
     /// Index of cable `cable`'s stored element (its reel end's node).
     fn stored(&self, cable: usize) -> usize {
-        let arms = (self.l.len() + 1) / (self.elements + 3);
-        arms * (self.elements + 1) + 2 * cable
+        self.arms * (self.elements + 1) + 2 * cable
     }
 
     /// The rows of every element from the nodes and spans set.
@@ -352,6 +354,8 @@ impl FeSpatial {
         rows.l[s..joint].fill(state[li]);
         rows.l_rate[s..joint].fill(state[np + li]);
         rows.l_acceleration[s..joint].fill(qdd[li]);
+        // The model's L0 as it is now (a public field), as `stored_element` reads it.
+        rows.coefficients.offset[s] = self.modelled_length;
         let (pulley, reel) = (self.pulley(cable), self.reels[cable]);
         let reel_end = [
             pulley + reel * state[li + 1],
@@ -433,8 +437,8 @@ mod tests {
             let total = 3.0;
             let mat = Material { ea: 1.0e4, mu: 0.05, gravity: 9.81 };
             let mut rows = StarRows::new(arms, &coefficients, &stored, total);
-            // Values spread from the seed; consecutive nodes about 0.1 m apart, so every
-            // element is taut or slack by the draw.
+            // Values spread from the seed: consecutive nodes 0.17 ± 0.1 m apart and every
+            // element's h 0.17 ± 0.05 m, so each one is taut or slack by the draw.
             let value = |j: usize, k: usize| seed[(7 * j + 3 * k) % seed.len()] * (1.0 + 0.01 * k as f64);
             let len = rows.l.len();
             for j in 0..=len {
@@ -443,9 +447,13 @@ mod tests {
                 }
             }
             for i in 0..len {
-                rows.l[i] = 0.5 + 0.1 * value(i, 1);
+                rows.l[i] = n as f64 * (0.17 + 0.05 * value(i, 1));
                 rows.l_rate[i] = value(i, 5);
                 rows.l_acceleration[i] = value(i, 11);
+            }
+            for a in 0..arms {
+                let s = rows.stored(a);
+                rows.l[s] = total - (0.17 + 0.05 * value(s, 1));
             }
             rows.evaluate(&mat, damping);
             let el = &rows;
