@@ -201,17 +201,15 @@ impl Factors {
         for (x, &g) in self.x.iter_mut().zip(gather) {
             *x = b[g];
         }
+        let n = self.u_inv_diag.len();
         if self.in_lanes {
             // The padding unknown of an odd order (if any) must enter as 0: a solve that
             // overflowed leaves it 0 · ∞ = NaN, which would poison every later solve.
-            let n = self.u_inv_diag.len();
             self.x[n..].fill(0.0);
             self.lanes.solve(&mut self.x);
         } else {
-            let n = self.u_inv_diag.len();
             self.rows.solve(&mut self.x[..n], &self.u_inv_diag);
         }
-        let n = self.u_inv_diag.len();
         &mut self.x[..n]
     }
 }

@@ -5,7 +5,8 @@
 //! unknown's updates chain through its stores and reloads. By rows, an unknown is accumulated in
 //! a register from unknowns already final, and stored once. Each row takes its entries in the
 //! order the column sweep applies them — L's by ascending column, U's by descending — so every
-//! unknown sees the same subtractions in the same order: the same bits as by columns.
+//! unknown sees the same subtractions in the same order: the same bits as by columns. The rows
+//! themselves are taken level by level ([`Rows::schedule`]), so that independent rows overlap.
 
 /// One strict triangle of the factors by rows, and where each of its column-ordered entries
 /// goes.
@@ -22,13 +23,14 @@ struct Rows {
 
 impl Rows {
     /// The row pattern of a triangle given by compressed columns (`ptr`, `row`) over `n`
-    /// unknowns, each row's entries in the order the columns are visited (`columns`).
+    /// unknowns, each row's entries in the order the columns are visited (`columns`, the
+    /// sweep's own order), the rows scheduled by level.
     fn plan(
         &mut self,
         n: usize,
         ptr: &[usize],
         row: &[usize],
-        columns: impl Iterator<Item = usize>,
+        columns: impl Iterator<Item = usize> + Clone,
     ) {
         let mut next = vec![0usize; n + 1];
         for &i in row {
@@ -45,7 +47,7 @@ impl Rows {
         self.val.resize(row.len(), 0.0);
         self.slot.clear();
         self.slot.resize(row.len(), 0);
-        for j in columns {
+        for j in columns.clone() {
             let column = ptr[j]..ptr[j + 1];
             for (k, &i) in column.clone().zip(&row[column]) {
                 self.slot[k] = next[i];
@@ -53,6 +55,7 @@ impl Rows {
                 next[i] += 1;
             }
         }
+        self.schedule(n, columns);
     }
 
     /// The rows ordered by level — a row's level one more than the highest level of the rows
@@ -122,8 +125,6 @@ impl RowSweeps {
         let n = l.0.len() - 1;
         self.lower.plan(n, l.0, l.1, 0..n);
         self.upper.plan(n, u.0, u.1, (0..n).rev());
-        self.lower.schedule(n, 0..n);
-        self.upper.schedule(n, (0..n).rev());
     }
 
     /// The factors' values, after each factorisation.

@@ -44,13 +44,6 @@ pub(super) struct StepStart<const D: usize> {
     remembered: Cell<Option<(f64, Reference<D>)>>,
 }
 
-impl<const D: usize> StepStart<D> {
-    /// Forgets the remembered reference (a run's start: the hold and the path are set there).
-    pub(super) fn forget_reference(&self) {
-        self.remembered.set(None);
-    }
-}
-
 impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
     /// The reels' power Σ T_i v_reel,i (or a driven reel's) and the model's dissipation [W] at
     /// t and `model_state` under `cmd`, the command there: remembered from the last call at t
@@ -76,7 +69,7 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
 
     /// Forgets the implicit path's remembered reference ([`StepStart::remembered`]).
     pub(crate) fn forget_reference(&self) {
-        self.step_start.forget_reference();
+        self.step_start.remembered.set(None);
     }
 
     /// [`ClosedLoop::reference`] at t, remembered from the last call at t (see

@@ -25,8 +25,9 @@ use nalgebra::Vector3;
 pub(super) enum Length {
     /// One of the span's N elements: h = l/N, h' = 1/N.
     Free(usize),
-    /// The stored element of a cable of total unstrained length L0 [m]: h = L0 − l, h' = −1.
-    Stored(f64),
+    /// A cable's stored element: h = L0 − l, h' = −1, L0 its total unstrained length, set
+    /// where it is read ([`StarRows::set_total_length`]; NaN until then).
+    Stored,
 }
 
 /// The elements' fixed mass coefficients and how each one's h follows l, element by element:
@@ -56,7 +57,7 @@ impl Coefficients {
             k.gamma.push(c.gamma);
             let (offset, slope, divisor, h_prime) = match length {
                 Length::Free(n) => (0.0, 1.0, n as f64, 1.0 / n as f64),
-                Length::Stored(total) => (total, -1.0, 1.0, -1.0),
+                Length::Stored => (f64::NAN, -1.0, 1.0, -1.0),
             };
             k.offset.push(offset);
             k.slope.push(slope);
@@ -232,13 +233,8 @@ pub(super) struct StarRows {
 
 impl StarRows {
     /// For `arms` ≥ 1 cables of N elements with the coefficients of elements e = 1 … N (index
-    /// e − 1), and their stored elements' coefficients and total unstrained length [m].
-    pub fn new(
-        arms: usize,
-        coefficients: &[MassCoefficients],
-        stored: &MassCoefficients,
-        total_length: f64,
-    ) -> Self {
+    /// e − 1), and their stored elements' coefficients.
+    pub fn new(arms: usize, coefficients: &[MassCoefficients], stored: &MassCoefficients) -> Self {
         let n = coefficients.len();
         let spans = arms * (n + 1);
         let len = spans + 2 * arms - 1;
@@ -247,7 +243,7 @@ impl StarRows {
             if i < spans {
                 (&coefficients[(i % (n + 1)).min(n - 1)], Length::Free(n))
             } else {
-                (stored, Length::Stored(total_length))
+                (stored, Length::Stored)
             }
         });
         Self {
@@ -265,6 +261,14 @@ impl StarRows {
     /// Index of cable `cable`'s stored element (its reel end's node).
     fn stored(&self, cable: usize) -> usize {
         self.arms * (self.elements + 1) + 2 * cable
+    }
+
+    /// Cable `cable`'s total unstrained length L0 [m], read by its stored element's h (and
+    /// by the joining pair after it, never read).
+    fn set_total_length(&mut self, cable: usize, total: f64) {
+        let s = self.stored(cable);
+        let joint = (s + 2).min(self.l.len());
+        self.coefficients.offset[s..joint].fill(total);
     }
 
     /// The rows of every element from the nodes and spans set.
@@ -355,7 +359,7 @@ impl FeSpatial {
         rows.l_rate[s..joint].fill(state[np + li]);
         rows.l_acceleration[s..joint].fill(qdd[li]);
         // The model's L0 as it is now (a public field), as `stored_element` reads it.
-        rows.coefficients.offset[s] = self.modelled_length;
+        rows.set_total_length(cable, self.modelled_length);
         let (pulley, reel) = (self.pulley(cable), self.reels[cable]);
         let reel_end = [
             pulley + reel * state[li + 1],
@@ -436,7 +440,10 @@ mod tests {
             let stored = MassCoefficients::new(mass, 0.0, 1.0);
             let total = 3.0;
             let mat = Material { ea: 1.0e4, mu: 0.05, gravity: 9.81 };
-            let mut rows = StarRows::new(arms, &coefficients, &stored, total);
+            let mut rows = StarRows::new(arms, &coefficients, &stored);
+            for a in 0..arms {
+                rows.set_total_length(a, total);
+            }
             // Values spread from the seed: consecutive nodes 0.17 ± 0.1 m apart and every
             // element's h 0.17 ± 0.05 m, so each one is taut or slack by the draw.
             let value = |j: usize, k: usize| seed[(7 * j + 3 * k) % seed.len()] * (1.0 + 0.01 * k as f64);

@@ -144,7 +144,7 @@ impl FeSpatial {
             material,
             axial_damping,
             reels,
-            rows: lanes::StarRows::new(m, &coefficients, &stored, modelled_length),
+            rows: lanes::StarRows::new(m, &coefficients, &stored),
             coefficients,
             stored_coefficients: stored,
             system: StarSystem::new(m, n - 1),
