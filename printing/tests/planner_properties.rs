@@ -704,3 +704,37 @@ fn extrusion_change_limits_a_straight_junction() {
     );
     assert!(close(plan.segments[1].start_v, v, 1e-12, 0.0));
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// `Plan::breakpoints` holds every time the reference may jump: between two consecutive
+    /// ones it is a single quadratic. At three interior points of each interval (intervals
+    /// under 1 ns skipped: a phase end and its breakpoint are sums rounded apart by an ulp) the
+    /// acceleration is the same bits (one phase: ±accel or 0 times the direction) and the
+    /// velocity moves by a·Δt to 1e-12 m/s (speeds below 1 m/s, a few ulp each); every segment's
+    /// start, where a junction turns the velocity, is one of them, and they ascend strictly.
+    #[test]
+    fn the_reference_is_one_quadratic_between_breakpoints(
+        config in random_limits(),
+        ops in prop::collection::vec(op(), 1..40),
+    ) {
+        let (text, _) = build(&config, &ops);
+        let plan = plan_text(&text, [0.0; 3], &config);
+        let b = plan.breakpoints();
+        prop_assert!(b.windows(2).all(|w| w[0] < w[1]), "{:?}", b);
+        for s in &plan.segments {
+            prop_assert!(b.contains(&s.t_start), "segment start {} missing", s.t_start);
+        }
+        for w in b.windows(2).filter(|w| w[1] - w[0] >= 1e-9) {
+            let ts = [0.25, 0.5, 0.75].map(|f| w[0] + f * (w[1] - w[0]));
+            let r = ts.map(|t| plan.reference(t).unwrap());
+            for k in 0..3 {
+                prop_assert_eq!(r[0].2[k].to_bits(), r[1].2[k].to_bits(), "in {:?}", w);
+                prop_assert_eq!(r[1].2[k].to_bits(), r[2].2[k].to_bits(), "in {:?}", w);
+                let moved = r[0].1[k] + r[0].2[k] * (ts[2] - ts[0]);
+                prop_assert!((r[2].1[k] - moved).abs() <= 1e-12, "in {:?}: {} against {}", w, r[2].1[k], moved);
+            }
+        }
+    }
+}

@@ -113,6 +113,27 @@ impl<const D: usize> PrintPath<D> {
         self.duration
     }
 
+    /// The loop's times [s] where the reference may jump in velocity or acceleration, ascending:
+    /// the plan's [`Plan::breakpoints`] delayed by each pulse of each axis's shaper (a shaped
+    /// axis is a sum of delayed copies of the plan, each with the plan's jumps).
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let plan = self.plan.breakpoints();
+        let mut delays = Vec::new();
+        for axis in Self::AXES {
+            match &self.shapers[axis] {
+                Some(shaper) => delays.extend(&shaper.offsets),
+                None => delays.push(0.0),
+            }
+        }
+        let mut times: Vec<f64> = delays
+            .iter()
+            .flat_map(|tau| plan.iter().map(move |b| self.lead + b + tau))
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        times
+    }
+
     /// Where the print starts [m].
     pub fn start(&self) -> Vector<D> {
         self.reference(0.0, false)[0]

@@ -115,6 +115,23 @@ impl Plan {
             .checked_sub(1)
     }
 
+    /// The plan's times [s] where its reference may jump in velocity or acceleration, ascending:
+    /// every segment's start (a junction turns the velocity at the junction speed, Klipper's
+    /// square-corner model) and the ends of its phases (the acceleration steps between ±a and
+    /// 0). Between two consecutive times the reference is a polynomial of degree ≤ 2, so an
+    /// error-controlled integrator that stops there never steps across a jump.
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let mut times = Vec::with_capacity(4 * self.segments.len());
+        for s in &self.segments {
+            let accel_end = s.t_start + s.accel_t;
+            let cruise_end = accel_end + s.cruise_t;
+            times.extend([s.t_start, accel_end, cruise_end, cruise_end + s.decel_t]);
+        }
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        times
+    }
+
     /// The reference at `t` [s]: on a segment, its trapezoid; between segments and after the
     /// last, at rest where the last one ended; before the first, at its start.
     pub fn reference(&self, t: f64) -> Option<Reference> {

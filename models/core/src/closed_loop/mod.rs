@@ -228,6 +228,16 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         }
     }
 
+    /// The times [s] where the reference may jump in velocity or acceleration: a print's
+    /// ([`crate::print_path::PrintPath::breakpoints`]); none for eq. 13, whose position, velocity and acceleration
+    /// are continuous (shaped or not: a sum of delayed copies).
+    pub fn reference_breakpoints(&self) -> Vec<f64> {
+        match &self.path {
+            Some(Path::Print(print)) => print.breakpoints(),
+            _ => Vec::new(),
+        }
+    }
+
     /// When the (shaped) reference reaches x2 [s]: t2 plus the shaper's duration (a print:
     /// when its shaped reference comes to rest).
     pub fn move_end(&self) -> f64 {

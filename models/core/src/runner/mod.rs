@@ -6,6 +6,7 @@ mod error;
 mod events;
 mod frames;
 mod sampler;
+mod stops;
 
 pub use error::{RunError, RunFailure};
 pub use events::EVENT_TIME_TOL;
@@ -13,6 +14,7 @@ use events::{EventMonitor, check_slack};
 use frames::FrameClock;
 pub use frames::{FrameSink, Frames};
 use sampler::Sampler;
+use stops::{Stops, gap};
 
 use crate::channel::Channel;
 use crate::closed_loop::ClosedLoop;
@@ -73,6 +75,14 @@ pub struct RunOptions {
 }
 
 impl RunOptions {
+    /// Whether the run stops at the reference's jumps and restarts past them ([`stops`]): the
+    /// error-controlled implicit path, whose error test cannot pass a step across one. The
+    /// fixed step keeps its grid (and its bits); DOPRI5 crosses a jump by shrinking its steps,
+    /// its error being O(h) there too but its allowance per unit step.
+    pub fn stops_at_reference_jumps(&self) -> bool {
+        self.integrator == IntegratorKind::Implicit && self.implicit.error_control.is_some()
+    }
+
     /// A DOPRI5 run to `t_final` [s], sampled every `sample_period` [s] (tests and studies that
     /// set the tolerances themselves).
     pub fn dopri5(t_final: f64, sample_period: f64, dopri: Dopri5Options) -> Self {
@@ -300,7 +310,7 @@ fn integrate_and_sample<M: CableModel<D>, const D: usize>(
         None => integrate(
             sys,
             &y0,
-            opts.t_final,
+            (opts.t_final, opts.stops_at_reference_jumps()),
             stepper,
             &mut sampler,
             &mut events,
@@ -372,7 +382,7 @@ fn unsupported<M: CableModel<D>, const D: usize>(
 fn integrate<M: CableModel<D>, const D: usize>(
     sys: &mut ClosedLoop<M, D>,
     y0: &[f64],
-    t_end: f64,
+    (t_end, stop_at_jumps): (f64, bool),
     stepper: &mut dyn Stepper<ClosedLoop<M, D>>,
     sampler: &mut Sampler,
     events: &mut Vec<ModelEvent>,
@@ -388,12 +398,20 @@ fn integrate<M: CableModel<D>, const D: usize>(
     sampler.sample_through(sys, stepper, 0.0)?;
     observer.emit(&sampler.series, 0, &mut row);
     clock.take_through(sys, stepper, 0.0, &mut observer.frames);
+    let jumps = if stop_at_jumps {
+        sys.reference_breakpoints()
+    } else {
+        Vec::new()
+    };
+    let mut stops = Stops::new(jumps, t_end);
     while stepper.time() < t_end {
         if observer.stopped() {
             return Err(RunError::Interrupted { t: stepper.time() });
         }
+        let jump = stops.after(stepper.time());
+        let target = jump.map_or(t_end, |b| b - gap(b));
         stepper
-            .step(sys, t_end)
+            .step(sys, target)
             .map_err(integrator(stepper.time()))?;
         let taken = sampler.series.len();
         let Some((index, t_event)) = monitor.earliest_crossing(sys, stepper) else {
@@ -408,6 +426,12 @@ fn integrate<M: CableModel<D>, const D: usize>(
             )?;
             monitor.accept(sys, stepper.state());
             (observer.progress)(t / t_end);
+            if let Some(b) = jump.filter(|_| t == target) {
+                // Across the jump from the same state ([`stops`]).
+                let y = stepper.state().to_vec();
+                stepper.restart(sys, b + gap(b), &y);
+                sys.forget_reference();
+            }
             continue;
         };
         // Samples up to the event come from the step as integrated; the event changes the state
