@@ -75,12 +75,16 @@ pub struct RunOptions {
 }
 
 impl RunOptions {
-    /// Whether the run stops at the reference's jumps and restarts past them ([`stops`]): the
-    /// error-controlled implicit path, whose error test cannot pass a step across one. The
-    /// fixed step keeps its grid (and its bits); DOPRI5 crosses a jump by shrinking its steps,
-    /// its error being O(h) there too but its allowance per unit step.
+    /// Whether the run stops at the reference's jumps and restarts past them ([`stops`]): every
+    /// integrator that controls its error, since a step across a jump has an error that shrinks
+    /// only as h (the error-controlled implicit path underflowed there; DOPRI5 crossed the cube
+    /// layer's jumps with 7 323 rejected steps, 1 814 with the stops). The fixed step keeps its
+    /// grid and its bits.
     pub fn stops_at_reference_jumps(&self) -> bool {
-        self.integrator == IntegratorKind::Implicit && self.implicit.error_control.is_some()
+        match self.integrator {
+            IntegratorKind::Dopri5 => true,
+            IntegratorKind::Implicit => self.implicit.error_control.is_some(),
+        }
     }
 
     /// A DOPRI5 run to `t_final` [s], sampled every `sample_period` [s] (tests and studies that
