@@ -23,6 +23,18 @@ fn hangprinter_printer() -> Scenario {
     cdpr_bench::scenario_from_file(std::path::Path::new(path)).unwrap()
 }
 
+/// The printer on massive lines of `kind` ("lumped", "fe") with `elements` per line, 3.2 m of
+/// each modelled (enough for the build volume's corners).
+fn printer_on_massive_lines(kind: &str, elements: i64) -> Scenario {
+    let mut scenario = hangprinter_printer();
+    scenario.cable.modelled_length = 3.2;
+    let mut table = toml::Table::new();
+    table.insert("kind".into(), kind.into());
+    table.insert("elements".into(), elements.into());
+    scenario.model = cdpr_bench::core::scenario::ModelSection(table);
+    scenario
+}
+
 /// A square of 20 mm sides at 100 mm/s, 3 000 mm/s², unshaped, at the robot's origin.
 fn square() -> PrintPath<3> {
     let text = "G1 X20 Y0 F6000\nG1 X20 Y20\nG1 X0 Y20\nG1 X0 Y0\n";
@@ -99,12 +111,7 @@ fn a_straight_printed_line_stays_on_its_line() {
 /// work), and the print is refused by name where the lines cannot reach it.
 #[test]
 fn a_straight_printed_line_on_lumped_lines() {
-    let mut scenario = hangprinter_printer();
-    scenario.cable.modelled_length = 3.2;
-    let mut table = toml::Table::new();
-    table.insert("kind".into(), "lumped".into());
-    table.insert("elements".into(), 20i64.into());
-    scenario.model = cdpr_bench::core::scenario::ModelSection(table);
+    let mut scenario = printer_on_massive_lines("lumped", 20);
     let gcode = "G28\nG1 X130 Y110 F6000\n";
     let print = cdpr_bench::prepare_print(&scenario, gcode, None).unwrap();
     let run = cdpr_bench::simulate_print(&scenario, &print, &mut Observer::progress(&mut |_| {}))
@@ -139,12 +146,7 @@ fn a_straight_printed_line_on_lumped_lines() {
 #[test]
 fn an_error_controlled_print_turns_its_corners() {
     use cdpr_bench::core::scenario::IntegratorKind;
-    let mut scenario = hangprinter_printer();
-    scenario.cable.modelled_length = 3.2;
-    let mut table = toml::Table::new();
-    table.insert("kind".into(), "fe".into());
-    table.insert("elements".into(), 4i64.into());
-    scenario.model = cdpr_bench::core::scenario::ModelSection(table);
+    let mut scenario = printer_on_massive_lines("fe", 4);
     scenario.simulation.integrator = IntegratorKind::Implicit;
     let gcode = "G28\nG1 X110 Y100 F6000\nG1 X110 Y110\nG1 X100 Y110\nG1 X100 Y100\n";
     let print = cdpr_bench::prepare_print(&scenario, gcode, None).unwrap();
