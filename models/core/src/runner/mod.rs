@@ -77,9 +77,8 @@ pub struct RunOptions {
 impl RunOptions {
     /// Whether the run stops at the reference's jumps and restarts past them ([`stops`]): every
     /// integrator that controls its error, since a step across a jump has an error that shrinks
-    /// only as h (the error-controlled implicit path underflowed there; DOPRI5 crossed the cube
-    /// layer's jumps with 7 323 rejected steps, 1 814 with the stops). The fixed step keeps its
-    /// grid and its bits.
+    /// only as h, which the error test chases down to round-off (the implicit path) or through
+    /// rejected steps (DOPRI5). The fixed step keeps its grid and its bits.
     pub fn stops_at_reference_jumps(&self) -> bool {
         match self.integrator {
             IntegratorKind::Dopri5 => true,
