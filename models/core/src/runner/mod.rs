@@ -14,7 +14,7 @@ use events::{EventMonitor, check_slack};
 use frames::FrameClock;
 pub use frames::{FrameSink, Frames};
 use sampler::Sampler;
-use stops::{Stops, gap};
+use stops::{Stops, restart_after_event};
 
 use crate::channel::Channel;
 use crate::closed_loop::ClosedLoop;
@@ -401,18 +401,14 @@ fn integrate<M: CableModel<D>, const D: usize>(
     sampler.sample_through(sys, stepper, 0.0)?;
     observer.emit(&sampler.series, 0, &mut row);
     clock.take_through(sys, stepper, 0.0, &mut observer.frames);
-    let jumps = if stop_at_jumps {
-        sys.reference_breakpoints()
-    } else {
-        Vec::new()
-    };
-    let mut stops = Stops::new(jumps, t_end);
+    let jumps = stop_at_jumps.then(|| sys.reference_breakpoints());
+    let mut stops = Stops::new(jumps.unwrap_or_default(), t_end);
     while stepper.time() < t_end {
         if observer.stopped() {
             return Err(RunError::Interrupted { t: stepper.time() });
         }
-        let jump = stops.after(stepper.time());
-        let target = jump.map_or(t_end, |b| b - gap(b));
+        let window = stops.after(stepper.time());
+        let target = window.map_or(t_end, |w| w.stop);
         stepper
             .step(sys, target)
             .map_err(integrator(stepper.time()))?;
@@ -429,10 +425,10 @@ fn integrate<M: CableModel<D>, const D: usize>(
             )?;
             monitor.accept(sys, stepper.state());
             (observer.progress)(t / t_end);
-            if let Some(b) = jump.filter(|_| t == target) {
-                // Across the jump from the same state ([`stops`]).
+            if let Some(w) = window.filter(|_| t == target) {
+                // Across the jumps from the same state ([`stops`]).
                 let y = stepper.state().to_vec();
-                stepper.restart(sys, b + gap(b), &y);
+                stepper.restart(sys, w.resume, &y);
                 sys.forget_reference();
             }
             continue;
@@ -448,7 +444,12 @@ fn integrate<M: CableModel<D>, const D: usize>(
         let event = sys.model.apply_event(index, t_event, &mut y[..n])?;
         sampler.event_energy += event.energy_change;
         events.push(event);
-        stepper.restart(sys, t_event, &y);
+        // An event by a stop restarts past its jumps, not a sliver before them ([`stops`]).
+        let t_restart = restart_after_event(t_event, window);
+        stepper.restart(sys, t_restart, &y);
+        if t_restart != t_event {
+            sys.forget_reference();
+        }
         check_slack(
             t_event,
             &sys.command(t_event, &y).tensions,
