@@ -733,7 +733,10 @@ proptest! {
                 prop_assert_eq!(r[0].2[k].to_bits(), r[1].2[k].to_bits(), "in {:?}", w);
                 prop_assert_eq!(r[1].2[k].to_bits(), r[2].2[k].to_bits(), "in {:?}", w);
                 let moved = r[0].1[k] + r[0].2[k] * (ts[2] - ts[0]);
-                prop_assert!((r[2].1[k] - moved).abs() <= 1e-12, "in {:?}: {} against {}", w, r[2].1[k], moved);
+                prop_assert!(
+                    (r[2].1[k] - moved).abs() <= 1e-12,
+                    "in {:?}: {} against {}", w, r[2].1[k], moved
+                );
             }
         }
     }

@@ -229,8 +229,8 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
     }
 
     /// The times [s] where the reference may jump in velocity or acceleration: a print's
-    /// ([`crate::print_path::PrintPath::breakpoints`]); none for eq. 13, whose position, velocity and acceleration
-    /// are continuous (shaped or not: a sum of delayed copies).
+    /// ([`crate::print_path::PrintPath::breakpoints`]); none for eq. 13, whose position,
+    /// velocity and acceleration are continuous (shaped or not: a sum of delayed copies).
     pub fn reference_breakpoints(&self) -> Vec<f64> {
         match &self.path {
             Some(Path::Print(print)) => print.breakpoints(),

@@ -429,7 +429,6 @@ fn integrate<M: CableModel<D>, const D: usize>(
                 // Across the jumps from the same state ([`stops`]).
                 let y = stepper.state().to_vec();
                 stepper.restart(sys, w.resume, &y);
-                sys.forget_reference();
             }
             continue;
         };
@@ -445,11 +444,7 @@ fn integrate<M: CableModel<D>, const D: usize>(
         sampler.event_energy += event.energy_change;
         events.push(event);
         // An event by a stop restarts past its jumps, not a sliver before them ([`stops`]).
-        let t_restart = restart_after_event(t_event, window);
-        stepper.restart(sys, t_restart, &y);
-        if t_restart != t_event {
-            sys.forget_reference();
-        }
+        stepper.restart(sys, restart_after_event(t_event, window), &y);
         check_slack(
             t_event,
             &sys.command(t_event, &y).tensions,

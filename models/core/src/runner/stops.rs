@@ -3,8 +3,8 @@
 //!
 //! A step across a jump in the command has a local error that shrinks only as h: the
 //! controller's states, advanced by the trapezoidal rule, take half the jump in their rate
-//! times h. The error test then cuts the step until it underflows (the FE cube print at
-//! t = 9.83 s: a corner's 4 mm/s turn of the reference velocity, h below 5e-13 s). A run that
+//! times h. The error test then cuts the step until it underflows (a print corner's 4 mm/s turn
+//! of the reference velocity takes h below 5e-13 s at atol 1e-9). A run that
 //! controls its error therefore ends a step just before each jump, where every evaluation sees
 //! the reference's old side, and restarts just after it from the same state, where it sees the
 //! new side. The state moves by O(v · 2 gap) [m] across the gap of a few picoseconds: far

@@ -6,10 +6,10 @@
 //! included) in its local unknowns and adding the blocks gives the global S at O(m N) kernel
 //! calls. The free elements' blocks are differenced all at once in lanes
 //! ([`super::block_lanes`]); the scalar [`FeSpatial::local_matrix`] differences the stored
-//! elements' and the effector's, and is the lanes' reference in their test. Coloured differences of the whole residual need one
-//! assembly per colour and, the l_i columns being dense in their span, far more colours (242
-//! residual sweeps per matrix at N = 10 with damping, against ~36 sweeps' worth of kernels
-//! here). The commanded tensions enter R linearly and drop out.
+//! elements' and the effector's, and is the lanes' reference in their test. Coloured
+//! differences of the whole residual need one assembly per colour and, the l_i columns being
+//! dense in their span, far more colours (242 residual sweeps per matrix at N = 10 with
+//! damping, against ~36 sweeps' worth of kernels here). The commanded tensions enter R linearly and drop out.
 
 use super::FeSpatial;
 use crate::element::{self, Chord, ElementState};
