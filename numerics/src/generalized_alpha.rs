@@ -273,6 +273,33 @@ impl GeneralizedAlpha {
         Ok(())
     }
 
+    /// S re-weighted for step h from the parts the system kept at its last evaluation
+    /// ([`SecondOrderSystem::reweighted_matrix`]) and factorised; false if it keeps none. The
+    /// parts' state is the last refresh's, so the refresh rule's count goes on.
+    fn reweigh<S: SecondOrderSystem + ?Sized>(
+        &mut self,
+        sys: &mut S,
+        t: f64,
+        h: f64,
+    ) -> Result<bool, IntegratorError> {
+        let (c_v, c_q) = self.coeff.derivatives(h);
+        let Some(cost) =
+            sys.reweighted_matrix(t, &self.y_try, &self.qdd_try, c_v, c_q, &mut self.values)
+        else {
+            return Ok(false);
+        };
+        self.stats.rhs_evals += cost.residual_evals;
+        let matrix = self
+            .matrix
+            .as_mut()
+            .ok_or(IntegratorError::Usage("step before start"))?;
+        matrix.factorise(&self.values)?;
+        self.stats.factorisations += 1;
+        self.stats.pivotings = matrix.pivotings();
+        self.matrix_h = h;
+        Ok(true)
+    }
+
     /// Modified Newton on R(q''_{n+1}) = 0 with the current factorisation of S, to max |R| ≤ `tol`.
     /// `fresh`: S was evaluated for this step, so a slow contraction means the step is too long
     /// for Newton, not that S has aged (see [`FRESH_CONTRACTION`]).
@@ -343,13 +370,23 @@ impl GeneralizedAlpha {
         self.y_try.copy_from_slice(&self.y);
         self.predict(h);
         let mut fresh = false;
+        let step_changed = (self.matrix_h / h - 1.0).abs() > STEP_CHANGE_REFRESH;
         if self.matrix_h == 0.0
-            || (self.matrix_h / h - 1.0).abs() > STEP_CHANGE_REFRESH
             || self.refresh_pays()
+            || (step_changed && self.opts.error_control.is_none())
         {
             self.kinematics(h);
             self.refresh(sys, t1, h)?;
             fresh = true;
+        } else if self.opts.error_control.is_some() && h != self.matrix_h {
+            // Under error control the step changes often: S is re-weighted for it where the
+            // system keeps its parts (a factorisation, no model evaluation), else refreshed
+            // beyond a quarter's change as on the fixed path.
+            self.kinematics(h);
+            if !self.reweigh(sys, t1, h)? && step_changed {
+                self.refresh(sys, t1, h)?;
+                fresh = true;
+            }
         }
         // The tolerance of MODELS.md §6, or the forces' round-off where that is larger.
         let tol = self.opts.newton_tol.max(sys.residual_round_off(&self.y));

@@ -173,6 +173,22 @@ pub trait SecondOrderSystem: OdeSystem {
         c_q: f64,
         values: &mut [f64],
     ) -> MatrixCost;
+    /// S for new coefficients (c_v, c_q) at the iterate, from what the last
+    /// [`Self::iteration_matrix`] kept where the system keeps it ([`crate::MatrixParts`]): the
+    /// parts evaluated at that call's state, as stale as a matrix kept across steps. None: the
+    /// system keeps nothing, and S is evaluated afresh.
+    #[allow(clippy::too_many_arguments)]
+    fn reweighted_matrix(
+        &mut self,
+        _t: f64,
+        _y: &[f64],
+        _qdd: &[f64],
+        _c_v: f64,
+        _c_q: f64,
+        _values: &mut [f64],
+    ) -> Option<MatrixCost> {
+        None
+    }
     /// Writes the tail `y[2n..]` at the end t of an accepted step whose q, q' are `y[..2n]`.
     fn end_step(&mut self, t: f64, y: &mut [f64]);
     /// The tail's rate at (t, y) into `out` (the dense output's derivative; q' and q'' come from

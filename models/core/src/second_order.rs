@@ -64,6 +64,14 @@ pub trait SecondOrderForm {
         c_q: f64,
         values: &mut [f64],
     ) -> MatrixCost;
+
+    /// S for new weights (c_v, c_q) from the parts the last [`Self::iteration_matrix`] kept, at
+    /// that call's state, without evaluating the model (`cdpr_numerics::MatrixParts`): a step-size
+    /// change of the error-controlled path then costs a factorisation, not a matrix. False where
+    /// the model keeps no parts.
+    fn reweighted_matrix(&self, _c_v: f64, _c_q: f64, _values: &mut [f64]) -> bool {
+        false
+    }
 }
 
 /// Round-off bound of a spring model's residual [N]: a node's force sums two springs, each

@@ -19,6 +19,7 @@ use crate::element::{self, Chord, ElementState};
 use crate::{Fe, TOWARD_REEL};
 use cdpr_core::second_order::{MatrixCost, SecondOrderForm, spring_round_off};
 use cdpr_numerics::differences::central_step;
+use cdpr_numerics::matrix_parts::{MatrixParts, weighted_entry};
 use nalgebra::Vector2;
 
 /// One additive block of R: an element, the rigid stored cable or the effector.
@@ -202,6 +203,77 @@ impl Fe {
         }
         local
     }
+    /// The difference quotients of `block` at (state, qdd): `numerators[k][row][col]` over
+    /// `widths[k][col]` is ∂R_row/∂u_col for u = q, q', q'' (k = 0, 1, 2), taken where `needed[k]`.
+    fn block_differences(
+        &self,
+        block: Block,
+        (dofs, len): (&LocalDofs, usize),
+        (state, qdd): (&[f64], &[f64]),
+        needed: [bool; 3],
+    ) -> BlockDifferences {
+        let [q, v, a] = self.gather(block, dofs, state, qdd);
+        let base = self.block_residual(block, &q, &v, &a);
+        let limit = self.block_step_limit(block, &q);
+        let mut d = BlockDifferences {
+            numerators: [[[0.0; 5]; 5]; 3],
+            widths: [[1.0; 5]; 3],
+        };
+        for col in 0..len {
+            if dofs[col].is_none() {
+                continue;
+            }
+            for which in (0..3).filter(|&k| needed[k]) {
+                // q'': linear, one forward difference is exact; q', q: central.
+                let x = [q, v, a][which][col];
+                let (plus, minus, width) = if which == 2 {
+                    let mut u = [q, v, a];
+                    u[which][col] = x + x.abs().max(1.0);
+                    let width = u[which][col] - x;
+                    (self.block_residual(block, &u[0], &u[1], &u[2]), base, width)
+                } else {
+                    let step = central_step(x, if which == 0 { limit } else { f64::INFINITY });
+                    let (mut up, mut down) = ([q, v, a], [q, v, a]);
+                    up[which][col] = x + step;
+                    down[which][col] = x - step;
+                    (
+                        self.block_residual(block, &up[0], &up[1], &up[2]),
+                        self.block_residual(block, &down[0], &down[1], &down[2]),
+                        up[which][col] - down[which][col],
+                    )
+                };
+                for row in 0..len {
+                    d.numerators[which][row][col] = plus[row] - minus[row];
+                }
+                d.widths[which][col] = width;
+            }
+        }
+        d
+    }
+
+    /// Visits every block's quotients ([`Self::block_differences`]) with the index, in the order
+    /// of [`SecondOrderForm::iteration_pattern`], of each entry it contributes.
+    fn for_each_entry(
+        &self,
+        (state, qdd): (&[f64], &[f64]),
+        needed: [bool; 3],
+        mut entry: impl FnMut(usize, [f64; 3], [f64; 3]),
+    ) {
+        let mut at = 0;
+        for block in self.blocks() {
+            let (dofs, len) = self.block_dofs(block);
+            let d = self.block_differences(block, (&dofs, len), (state, qdd), needed);
+            for row in (0..len).filter(|&row| dofs[row].is_some()) {
+                for col in (0..len).filter(|&col| dofs[col].is_some()) {
+                    let numerators = [0, 1, 2].map(|k| d.numerators[k][row][col]);
+                    let widths = [0, 1, 2].map(|k| d.widths[k][col]);
+                    entry(at, numerators, widths);
+                    at += 1;
+                }
+            }
+        }
+    }
+
     /// w_q ∂R/∂q + w_v ∂R/∂q' + w_a ∂R/∂q'' (weights `[w_q, w_v, w_a]`) at (state, qdd), block by
     /// block in the order of [`SecondOrderForm::iteration_pattern`] (duplicates summed by the
     /// caller): the iteration matrix S, and with weights [1, 0, 0] the static stiffness.
@@ -212,58 +284,26 @@ impl Fe {
         weights: [f64; 3],
         values: &mut [f64],
     ) {
-        let mut at = 0;
-        for block in self.blocks() {
-            let (dofs, len) = self.block_dofs(block);
-            let [q, v, a] = self.gather(block, &dofs, state, qdd);
-            let base = self.block_residual(block, &q, &v, &a);
-            let limit = self.block_step_limit(block, &q);
-            // local[row][col] of the weighted sum.
-            let mut local = [[0.0; 5]; 5];
-            for col in 0..len {
-                if dofs[col].is_none() {
-                    continue;
-                }
-                for (which, weight) in weights.into_iter().enumerate() {
-                    if weight == 0.0 {
-                        continue;
-                    }
-                    // q'': linear, one forward difference is exact; q', q: central.
-                    let x = [q, v, a][which][col];
-                    let (plus, minus, width) = if which == 2 {
-                        let mut u = [q, v, a];
-                        u[which][col] = x + x.abs().max(1.0);
-                        let width = u[which][col] - x;
-                        (self.block_residual(block, &u[0], &u[1], &u[2]), base, width)
-                    } else {
-                        let step = central_step(x, if which == 0 { limit } else { f64::INFINITY });
-                        let (mut up, mut down) = ([q, v, a], [q, v, a]);
-                        up[which][col] = x + step;
-                        down[which][col] = x - step;
-                        (
-                            self.block_residual(block, &up[0], &up[1], &up[2]),
-                            self.block_residual(block, &down[0], &down[1], &down[2]),
-                            up[which][col] - down[which][col],
-                        )
-                    };
-                    for row in 0..len {
-                        local[row][col] += weight * (plus[row] - minus[row]) / width;
-                    }
-                }
-            }
-            for row in 0..len {
-                if dofs[row].is_none() {
-                    continue;
-                }
-                for col in 0..len {
-                    if dofs[col].is_some() {
-                        values[at] = local[row][col];
-                        at += 1;
-                    }
-                }
-            }
-        }
+        let needed = weights.map(|w| w != 0.0);
+        self.for_each_entry((state, qdd), needed, |at, numerators, widths| {
+            values[at] = weighted_entry(weights, numerators, widths);
+        });
     }
+
+    /// Every entry's three quotients into `parts` (see [`MatrixParts`]).
+    fn block_parts(&self, state: &[f64], qdd: &[f64], parts: &mut MatrixParts) {
+        parts.start(self.iteration_pattern().len());
+        self.for_each_entry((state, qdd), [true; 3], |at, numerators, widths| {
+            parts.set(at, numerators, widths);
+        });
+        parts.finish();
+    }
+}
+
+/// One block's difference quotients ([`Fe::block_differences`]).
+struct BlockDifferences {
+    numerators: [[[f64; 5]; 5]; 3],
+    widths: [[f64; 5]; 3],
 }
 
 impl SecondOrderForm for Fe {
@@ -403,9 +443,18 @@ impl SecondOrderForm for Fe {
         c_q: f64,
         values: &mut [f64],
     ) -> MatrixCost {
-        self.block_matrix(state, qdd, [c_q, c_v, 1.0], values);
+        // The quotients kept for a later step size ([`Self::reweighted_matrix`]); weighed as
+        // `block_matrix` weighs them as it takes them, so S is the same to the bit.
+        let mut parts = std::mem::take(&mut self.matrix_parts);
+        self.block_parts(state, qdd, &mut parts);
+        parts.weigh([c_q, c_v, 1.0], values);
+        self.matrix_parts = parts;
         // Element-local differences, no full residual: one base and 5 × (1 + 2 + 2) probes per
         // block, the cost of about 26 residual sweeps, which is the refresh rule's price.
         MatrixCost::without_residuals(26)
+    }
+
+    fn reweighted_matrix(&self, c_v: f64, c_q: f64, values: &mut [f64]) -> bool {
+        self.matrix_parts.weigh([c_q, c_v, 1.0], values)
     }
 }

@@ -110,6 +110,9 @@ pub struct Fe {
     chord_inv_length: Vec<f64>,
     /// The implicit residual's chain elements (fixed coefficients, rows per evaluation).
     chain_rows: lanes::ChainRows,
+    /// The last iteration matrix's difference quotients, for a new step size
+    /// (`SecondOrderForm::reweighted_matrix`).
+    matrix_parts: cdpr_numerics::MatrixParts,
 }
 
 impl Fe {
@@ -166,6 +169,7 @@ impl Fe {
             chord_length: vec![0.0; nodes - 1],
             chord_inv_length: vec![0.0; nodes - 1],
             chain_rows,
+            matrix_parts: cdpr_numerics::MatrixParts::default(),
         })
     }
 

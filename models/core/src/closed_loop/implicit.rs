@@ -154,6 +154,70 @@ impl<M: CableModel<D>, const D: usize> ClosedLoop<M, D> {
         }
         slope
     }
+
+    /// S of the loop at the iterate for (c_v, c_q) into `values`: the model's part (evaluated,
+    /// or with `reweighted` re-weighted from its kept parts; None if it keeps none, or if the
+    /// model has no second-order form), then the tension rows' columns of the measured effector
+    /// coordinates, ∂R/∂T · dT/dq, by residuals (R is linear in T) at the iterate.
+    fn loop_matrix(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        qdd: &[f64],
+        (c_v, c_q): (f64, f64),
+        values: &mut [f64],
+        reweighted: bool,
+    ) -> Option<MatrixCost> {
+        let columns = self.effector_columns().1;
+        let form = self.model.second_order()?;
+        // The pattern is the model's, then one entry (row, column) per tension row and column.
+        let model_entries = values.len() - form.tension_rows().len() * columns;
+        if reweighted && !form.reweighted_matrix(c_v, c_q, &mut values[..model_entries]) {
+            return None;
+        }
+        self.drive_reels_at(t);
+        let n = self.model_len();
+        let effector = self.model.effector(&y[..n]);
+        let mut states = [0.0; MAX_CONTROLLER_STATES];
+        let tensions = self.step_end_command(t, &effector, &mut states).tensions;
+        let mut slopes = [Tensions::zeros(tensions.len()); MAX_AXES];
+        for (k, slope) in slopes.iter_mut().enumerate().take(columns) {
+            *slope = self.tension_slope(t, &effector, &tensions, k, c_v, c_q);
+        }
+        let [base, probe] = &mut self.residual_scratch;
+        let form = self.model.second_order_mut()?;
+        let rows = form.tension_rows();
+        let (model_values, tension_values) = values.split_at_mut(model_entries);
+        let mut cost = if reweighted {
+            MatrixCost::default()
+        } else {
+            form.iteration_matrix(&y[..n], qdd, &tensions, c_v, c_q, model_values)
+        };
+        base.resize(form.dofs(), 0.0);
+        probe.resize(form.dofs(), 0.0);
+        let mut base_done = false;
+        for (slope, column_values) in slopes[..columns]
+            .iter()
+            .zip(tension_values.chunks_mut(rows.len().max(1)))
+        {
+            if slope.iter().all(|&s| s == 0.0) || rows.is_empty() {
+                column_values.fill(0.0);
+                continue;
+            }
+            if !base_done {
+                form.residual(&y[..n], qdd, &tensions, base);
+                cost = cost.plus_residuals(1);
+                base_done = true;
+            }
+            let pulled = Tensions::from_fn(tensions.len(), |i| tensions[i] + slope[i]);
+            form.residual(&y[..n], qdd, &pulled, probe);
+            cost = cost.plus_residuals(1);
+            for (value, &row) in column_values.iter_mut().zip(&rows) {
+                *value = c_q * (probe[row] - base[row]);
+            }
+        }
+        Some(cost)
+    }
 }
 
 impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
@@ -230,50 +294,20 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         c_q: f64,
         values: &mut [f64],
     ) -> MatrixCost {
-        self.drive_reels_at(t);
-        let n = self.model_len();
-        let effector = self.model.effector(&y[..n]);
-        let mut states = [0.0; MAX_CONTROLLER_STATES];
-        let tensions = self.step_end_command(t, &effector, &mut states).tensions;
-        let columns = self.effector_columns().1;
-        let mut slopes = [Tensions::zeros(tensions.len()); MAX_AXES];
-        for (k, slope) in slopes.iter_mut().enumerate().take(columns) {
-            *slope = self.tension_slope(t, &effector, &tensions, k, c_v, c_q);
-        }
-        let [base, probe] = &mut self.residual_scratch;
-        let Some(form) = self.model.second_order_mut() else {
-            return MatrixCost::default();
-        };
-        // The pattern is the model's, then one entry (row, column) per tension row and column.
-        let rows = form.tension_rows();
-        let (model_values, tension_values) =
-            values.split_at_mut(values.len() - rows.len() * columns);
-        let mut cost = form.iteration_matrix(&y[..n], qdd, &tensions, c_v, c_q, model_values);
-        base.resize(form.dofs(), 0.0);
-        probe.resize(form.dofs(), 0.0);
-        let mut base_done = false;
-        for (slope, column_values) in slopes[..columns]
-            .iter()
-            .zip(tension_values.chunks_mut(rows.len().max(1)))
-        {
-            if slope.iter().all(|&s| s == 0.0) || rows.is_empty() {
-                column_values.fill(0.0);
-                continue;
-            }
-            // The column of ∂R/∂T · dT/dq, by residuals (R is linear in T).
-            if !base_done {
-                form.residual(&y[..n], qdd, &tensions, base);
-                cost = cost.plus_residuals(1);
-                base_done = true;
-            }
-            let pulled = Tensions::from_fn(tensions.len(), |i| tensions[i] + slope[i]);
-            form.residual(&y[..n], qdd, &pulled, probe);
-            cost = cost.plus_residuals(1);
-            for (value, &row) in column_values.iter_mut().zip(&rows) {
-                *value = c_q * (probe[row] - base[row]);
-            }
-        }
-        cost
+        self.loop_matrix(t, y, qdd, (c_v, c_q), values, false)
+            .unwrap_or_default()
+    }
+
+    fn reweighted_matrix(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        qdd: &[f64],
+        c_v: f64,
+        c_q: f64,
+        values: &mut [f64],
+    ) -> Option<MatrixCost> {
+        self.loop_matrix(t, y, qdd, (c_v, c_q), values, true)
     }
 
     fn tail_rate(&mut self, t: f64, y: &[f64], out: &mut [f64]) {
