@@ -48,7 +48,9 @@ pub struct GeneralizedAlphaOptions {
     /// matrix contracts by 1e-3 … 1e-2 on the paper's meshes (lumped N = 40, FE N = 10; at
     /// N = 1000 by up to 0.06–0.08, see `FRESH_CONTRACTION`); 0.05 (measured on the paper run, from
     /// 0.005 … 0.5) minimises the total work: ~2 iterations per step for FE with a dozen
-    /// factorisations per 5 s, where 0.5 lets the matrix age into ~3 iterations per step.
+    /// factorisations per 5 s, where 0.5 lets the matrix age into ~3 iterations per step. A
+    /// model whose matrix is dear and ages in a step may state its own
+    /// ([`MatrixCost::slow_contraction`]).
     pub slow_contraction: f64,
     /// Smallest step before giving up [s].
     pub min_step: f64,
@@ -127,6 +129,9 @@ pub struct GeneralizedAlpha {
     /// one per step spent since (the refresh rule of [`Self::refresh_pays`]).
     refresh_price: u64,
     excess_iterations: u64,
+    /// The last refresh's limit on a kept matrix's contraction
+    /// ([`MatrixCost::slow_contraction`], else the options').
+    slow_contraction: f64,
     stats: SolverStats,
 }
 
@@ -157,6 +162,7 @@ impl GeneralizedAlpha {
             matrix: None,
             matrix_h: 0.0,
             refresh_price: 0,
+            slow_contraction: opts.slow_contraction,
             excess_iterations: 0,
             stats: SolverStats::default(),
         }
@@ -261,6 +267,7 @@ impl GeneralizedAlpha {
         self.stats.rhs_evals += cost.residual_evals;
         self.stats.jacobian_evals += 1;
         self.refresh_price = cost.refresh_price;
+        self.slow_contraction = cost.slow_contraction.unwrap_or(self.opts.slow_contraction);
         self.excess_iterations = 0;
         let matrix = self
             .matrix
@@ -314,7 +321,7 @@ impl GeneralizedAlpha {
         let limit = if fresh {
             FRESH_CONTRACTION
         } else {
-            self.opts.slow_contraction
+            self.slow_contraction
         };
         let mut previous = f64::INFINITY;
         for iterations in 0..=self.opts.max_iterations as u64 {
@@ -576,6 +583,7 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
         let pattern = sys.iteration_pattern();
         self.values = vec![0.0; pattern.len()];
         (self.refresh_price, self.excess_iterations) = (0, 0);
+        self.slow_contraction = self.opts.slow_contraction;
         self.matrix = Some(IterationMatrix::with_coupled(
             n,
             &pattern,

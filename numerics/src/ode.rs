@@ -13,14 +13,18 @@ use crate::sparse;
 /// (an iteration costs a residual and a solve); a model that knows better (a refresh that buys
 /// fewer iterations than it costs, or an analytic matrix whose factorisation dominates) states
 /// its own price, with its measurements. A price of 0 (the `Default`) means: refresh only when
-/// Newton slows.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+/// Newton slows. A model may likewise state how slow a Newton contraction its kept matrix may
+/// show before it counts as aged.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct MatrixCost {
     /// Full residual evaluations made.
     pub residual_evals: u64,
     /// The refresh rule's price of this refresh, in Newton iterations beyond one per step
     /// (0: the matrix is refreshed only when Newton slows).
     pub refresh_price: u64,
+    /// The contraction per Newton iteration beyond which this matrix, kept across steps, is
+    /// re-evaluated (None: the integrator's `slow_contraction`).
+    pub slow_contraction: Option<f64>,
 }
 
 impl MatrixCost {
@@ -30,6 +34,7 @@ impl MatrixCost {
         Self {
             residual_evals: evals,
             refresh_price: evals,
+            slow_contraction: None,
         }
     }
 
@@ -39,6 +44,16 @@ impl MatrixCost {
         Self {
             residual_evals: 0,
             refresh_price,
+            slow_contraction: None,
+        }
+    }
+
+    /// This cost with the model's own limit on a kept matrix's contraction
+    /// ([`Self::slow_contraction`]).
+    pub fn with_slow_contraction(self, limit: f64) -> Self {
+        Self {
+            slow_contraction: Some(limit),
+            ..self
         }
     }
 
@@ -48,6 +63,7 @@ impl MatrixCost {
         Self {
             residual_evals: self.residual_evals + evals,
             refresh_price: self.refresh_price + evals,
+            ..self
         }
     }
 }
