@@ -269,6 +269,11 @@ impl GeneralizedAlpha {
         self.refresh_price = cost.refresh_price;
         self.slow_contraction = cost.slow_contraction.unwrap_or(self.opts.slow_contraction);
         self.excess_iterations = 0;
+        self.factorise(h)
+    }
+
+    /// Factorises the values just written as S for step h.
+    fn factorise(&mut self, h: f64) -> Result<(), IntegratorError> {
         let matrix = self
             .matrix
             .as_mut()
@@ -296,14 +301,7 @@ impl GeneralizedAlpha {
             return Ok(false);
         };
         self.stats.rhs_evals += cost.residual_evals;
-        let matrix = self
-            .matrix
-            .as_mut()
-            .ok_or(IntegratorError::Usage("step before start"))?;
-        matrix.factorise(&self.values)?;
-        self.stats.factorisations += 1;
-        self.stats.pivotings = matrix.pivotings();
-        self.matrix_h = h;
+        self.factorise(h)?;
         Ok(true)
     }
 
