@@ -141,13 +141,19 @@ impl SecondOrderForm for FeSpatial {
             self.block_matrix(state, qdd, [c_q, c_v, 1.0], values);
         }
         // No full residual: per block one base and 7 × (1 + 2 + 2) kernel probes, the kernels
-        // of about 36 residual sweeps, which is the refresh rule's price.
-        MatrixCost::without_residuals(BLOCK_MATRIX_PRICE).with_slow_contraction(KEPT_CONTRACTION)
+        // of about 36 residual sweeps.
+        MatrixCost::without_residuals(REFRESH_PRICE).with_slow_contraction(KEPT_CONTRACTION)
     }
 }
 
-/// The refresh rule's price of an element-by-element matrix, in residual sweeps.
-const BLOCK_MATRIX_PRICE: u64 = 36;
+/// The refresh rule's price of an element-by-element matrix, in Newton iterations beyond one
+/// per step: four times its cost of ~36 residual sweeps, because a refresh buys back less than
+/// it costs. The matrix ages within a step or two wherever the lines move (see
+/// [`KEPT_CONTRACTION`]), so the iterations it saves stop soon after it. Measured (criterion,
+/// one sitting) at 36, 144 and 576: the cube layer 11 339, 6 226 and 5 680 matrices for 1.364,
+/// 1.382 and 1.386 M residuals, 2.43, 2.35 and 2.36 s; the Hangprinter move 1 201, 313 and 81
+/// factorisations for 152 838, 151 310 and 151 675 residuals.
+const REFRESH_PRICE: u64 = 144;
 
 /// How slowly Newton may contract on a kept element matrix before it is re-evaluated. The
 /// matrix ages within one step wherever the lines' string motion turns the elements (the
