@@ -13,7 +13,8 @@
 //! Central differences with δ = ε^(1/3)·max(|u|, 1e-2) are accurate to ~1e-10 relative (as in
 //! [`cdpr_numerics::differences::ColouredDifferences`]), the position steps kept within a quarter
 //! of the element's stretch ([`cdpr_numerics::differences::central_step`]); the derivative in q''
-//! is linear and exact.
+//! is linear and exact. The quotients are kept, so that a new step size re-weighs them
+//! ([`cdpr_numerics::MatrixParts`]) instead of differencing again.
 
 use crate::element::{self, Chord, ElementState};
 use crate::{Fe, TOWARD_REEL};
@@ -203,6 +204,7 @@ impl Fe {
         }
         local
     }
+
     /// The difference quotients of `block` at (state, qdd): `numerators[k][row][col]` over
     /// `widths[k][col]` is ∂R_row/∂u_col for u = q, q', q'' (k = 0, 1, 2), taken where `needed[k]`.
     fn block_differences(
