@@ -135,6 +135,9 @@ fn a_straight_printed_line_on_lumped_lines() {
     assert!(err.to_string().contains("cable.modelled_length"), "{err}");
 }
 
+/// A 10 mm square from home at 100 mm/s, the corner tests' G-code.
+const SMALL_SQUARE: &str = "G28\nG1 X110 Y100 F6000\nG1 X110 Y110\nG1 X100 Y110\nG1 X100 Y100\n";
+
 /// A printed square's corners turn the reference's velocity at the junction speed (Klipper's
 /// square-corner model: 5 mm/s here), a jump in the command that a step across cannot make
 /// small: the controller's states take half the jump in their rate times h. The
@@ -148,7 +151,7 @@ fn an_error_controlled_print_turns_its_corners() {
     use cdpr_bench::core::scenario::IntegratorKind;
     let mut scenario = printer_on_massive_lines("fe", 4);
     scenario.simulation.integrator = IntegratorKind::Implicit;
-    let gcode = "G28\nG1 X110 Y100 F6000\nG1 X110 Y110\nG1 X100 Y110\nG1 X100 Y100\n";
+    let gcode = SMALL_SQUARE;
     let print = cdpr_bench::prepare_print(&scenario, gcode, None).unwrap();
     let run =
         |s: &Scenario| cdpr_bench::simulate_print(s, &print, &mut Observer::progress(&mut |_| {}));
@@ -176,7 +179,7 @@ fn an_error_controlled_print_turns_its_corners() {
 #[test]
 fn dopri5_prints_converge_across_their_corners() {
     let mut scenario = hangprinter_printer();
-    let gcode = "G28\nG1 X110 Y100 F6000\nG1 X110 Y110\nG1 X100 Y110\nG1 X100 Y100\n";
+    let gcode = SMALL_SQUARE;
     let print = cdpr_bench::prepare_print(&scenario, gcode, None).unwrap();
     let mut run = |rtol: f64| {
         scenario.simulation.rtol = rtol;

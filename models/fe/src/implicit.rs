@@ -292,9 +292,10 @@ impl Fe {
         });
     }
 
-    /// Every entry's three quotients into `parts` (see [`MatrixParts`]).
-    fn block_parts(&self, state: &[f64], qdd: &[f64], parts: &mut MatrixParts) {
-        parts.start(self.iteration_pattern().len());
+    /// Every entry's three quotients into `parts` (see [`MatrixParts`]), `entries` of them (the
+    /// pattern's length).
+    fn block_parts(&self, state: &[f64], qdd: &[f64], entries: usize, parts: &mut MatrixParts) {
+        parts.start(entries);
         self.for_each_entry((state, qdd), [true; 3], |at, numerators, widths| {
             parts.set(at, numerators, widths);
         });
@@ -448,7 +449,7 @@ impl SecondOrderForm for Fe {
         // The quotients kept for a later step size ([`Self::reweighted_matrix`]); weighed as
         // `block_matrix` weighs them as it takes them, so S is the same to the bit.
         let mut parts = std::mem::take(&mut self.matrix_parts);
-        self.block_parts(state, qdd, &mut parts);
+        self.block_parts(state, qdd, values.len(), &mut parts);
         parts.weigh([c_q, c_v, 1.0], values);
         self.matrix_parts = parts;
         // Element-local differences, no full residual: one base and 5 × (1 + 2 + 2) probes per

@@ -403,6 +403,8 @@ fn integrate<M: CableModel<D>, const D: usize>(
     clock.take_through(sys, stepper, 0.0, &mut observer.frames);
     let jumps = stop_at_jumps.then(|| sys.reference_breakpoints());
     let mut stops = Stops::new(jumps.unwrap_or_default(), t_end);
+    // The state a restart starts from (at a stop, or changed by an event).
+    let mut restart_state = vec![0.0; y0.len()];
     while stepper.time() < t_end {
         if observer.stopped() {
             return Err(RunError::Interrupted { t: stepper.time() });
@@ -427,8 +429,8 @@ fn integrate<M: CableModel<D>, const D: usize>(
             (observer.progress)(t / t_end);
             if let Some(w) = window.filter(|_| t == target) {
                 // Across the jumps from the same state ([`stops`]).
-                let y = stepper.state().to_vec();
-                stepper.restart(sys, w.resume, &y);
+                restart_state.copy_from_slice(stepper.state());
+                stepper.restart(sys, w.resume, &restart_state);
             }
             continue;
         };
@@ -437,20 +439,20 @@ fn integrate<M: CableModel<D>, const D: usize>(
         sampler.sample_through(sys, stepper, t_event)?;
         observer.emit(&sampler.series, taken, &mut row);
         clock.take_through(sys, stepper, t_event, &mut observer.frames);
-        let mut y = vec![0.0; y0.len()];
-        stepper.dense_output(t_event, &mut y);
+        let y = &mut restart_state[..];
+        stepper.dense_output(t_event, y);
         let n = sys.model_len();
         let event = sys.model.apply_event(index, t_event, &mut y[..n])?;
         sampler.event_energy += event.energy_change;
         events.push(event);
         // An event by a stop restarts past its jumps, not a sliver before them ([`stops`]).
-        stepper.restart(sys, restart_after_event(t_event, window), &y);
+        stepper.restart(sys, restart_after_event(t_event, window), y);
         check_slack(
             t_event,
-            &sys.command(t_event, &y).tensions,
+            &sys.command(t_event, y).tensions,
             sys.slack_allowed(),
         )?;
-        monitor.accept(sys, &y);
+        monitor.accept(sys, y);
     }
     Ok(())
 }

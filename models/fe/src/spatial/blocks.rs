@@ -9,7 +9,8 @@
 //! elements' and the effector's, and is the lanes' reference in their test. Coloured
 //! differences of the whole residual need one assembly per colour and, the l_i columns being
 //! dense in their span, far more colours (242 residual sweeps per matrix at N = 10 with
-//! damping, against ~36 sweeps' worth of kernels here). The commanded tensions enter R linearly and drop out.
+//! damping, against ~36 sweeps' worth of kernels here). The commanded tensions enter R
+//! linearly and drop out.
 
 use super::FeSpatial;
 use crate::element::{self, Chord, ElementState};
