@@ -48,7 +48,7 @@ pub mod riccati;
 pub mod small_cholesky;
 pub mod sparse;
 
-pub use alpha_error::ErrorControl;
+pub use alpha_error::{ErrorControl, ErrorPositions};
 pub use dopri5::{Dopri5, Dopri5Options};
 pub use generalized_alpha::{AlphaCoefficients, GeneralizedAlpha, GeneralizedAlphaOptions};
 pub use matrix_parts::MatrixParts;

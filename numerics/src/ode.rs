@@ -215,6 +215,11 @@ pub trait SecondOrderSystem: OdeSystem {
     fn residual_round_off(&self, _y: &[f64]) -> f64 {
         0.0
     }
+    /// The positions a user's quantity of interest lives in (a robot's effector): all that an
+    /// error norm on [`crate::ErrorPositions::Principal`] measures. Default: every position.
+    fn principal_positions(&self) -> Vec<usize> {
+        (0..self.dofs()).collect()
+    }
     /// The state's first `error_len` components enter an error-controlled integrator's norm
     /// (q, and the tail up to where audit states begin; the velocities are left to the
     /// method, see `alpha_error`). Default: all.

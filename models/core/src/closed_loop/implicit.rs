@@ -321,6 +321,13 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
         self.controller_and_audit_rates(y, (&reference, &effector), cmd.saturated, audits, out);
     }
 
+    /// The effector's coordinates.
+    fn principal_positions(&self) -> Vec<usize> {
+        self.model.second_order().map_or_else(Vec::new, |f| {
+            (0..D).map(|k| f.effector_coordinate(k)).collect()
+        })
+    }
+
     /// The model's and the controller's states; the energy audits stay out of the norm.
     fn error_len(&self) -> usize {
         self.dynamic_len()

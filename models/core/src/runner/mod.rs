@@ -20,11 +20,11 @@ use crate::channel::Channel;
 use crate::closed_loop::ClosedLoop;
 use crate::controller::Controller;
 use crate::model::{CableModel, Equilibrium, ModelEvent};
-use crate::scenario::{ImplicitMethod, IntegratorKind, Scenario};
+use crate::scenario::{ErrorNorm, ImplicitMethod, IntegratorKind, Scenario};
 use crate::series::{SeriesBuffer, TimeSeries};
 use cdpr_numerics::{
-    Dopri5, Dopri5Options, ErrorControl, GeneralizedAlpha, GeneralizedAlphaOptions, SolverStats,
-    Stepper,
+    Dopri5, Dopri5Options, ErrorControl, ErrorPositions, GeneralizedAlpha, GeneralizedAlphaOptions,
+    SolverStats, Stepper,
 };
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -120,6 +120,10 @@ impl From<&Scenario> for RunOptions {
                         rtol: sim.rtol,
                         atol: sim.atol,
                         max_step: s.largest_implicit_step(),
+                        positions: match sim.error_norm {
+                            ErrorNorm::All => ErrorPositions::All,
+                            ErrorNorm::Effector => ErrorPositions::Principal,
+                        },
                     }),
                     ..GeneralizedAlphaOptions::default()
                 },

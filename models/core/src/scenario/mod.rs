@@ -331,6 +331,38 @@ pub struct Simulation {
     /// run's provenance only when on, so that today's results stay byte for byte).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub adaptive: bool,
+    /// What the error control of an `adaptive` implicit run measures (written into a run's
+    /// provenance only when not the default).
+    #[serde(skip_serializing_if = "ErrorNorm::is_all")]
+    pub error_norm: ErrorNorm,
+}
+
+/// The coordinates whose local error an `adaptive` implicit run holds within its tolerances.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ErrorNorm {
+    /// Every position of the model and the controller's states, as DOPRI5 measures them.
+    #[default]
+    All,
+    /// The effector's position and the controller's states: the cables' own vibrations (a
+    /// lumped line's nodes ringing at µm long after the effector has settled) are integrated at
+    /// the effector's steps and, where those do not resolve them, damped by ρ∞ as on the fixed
+    /// step (docs/numerics.md).
+    Effector,
+}
+
+impl ErrorNorm {
+    /// The scenario file's spelling.
+    pub fn name(self) -> &'static str {
+        match self {
+            ErrorNorm::All => "all",
+            ErrorNorm::Effector => "effector",
+        }
+    }
+
+    fn is_all(&self) -> bool {
+        *self == ErrorNorm::All
+    }
 }
 
 impl Default for Simulation {
@@ -346,6 +378,7 @@ impl Default for Simulation {
             step: 1e-4,
             rho_inf: 0.9,
             adaptive: false,
+            error_norm: ErrorNorm::All,
         }
     }
 }

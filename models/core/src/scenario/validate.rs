@@ -179,6 +179,14 @@ impl Scenario {
                  `adaptive` switches the implicit integrator's error control on)",
             ));
         }
+        if s.error_norm != ErrorNorm::All && !s.adaptive {
+            return Err(out_of_range(
+                "simulation.error_norm",
+                s.error_norm.name(),
+                "\"all\" unless adaptive = true (the norm of the implicit integrator's error \
+                 control)",
+            ));
+        }
         finite("simulation.rho_inf", s.rho_inf)?;
         if !(0.0..=1.0).contains(&s.rho_inf) {
             return Err(out_of_range("simulation.rho_inf", s.rho_inf, "[0, 1]"));
