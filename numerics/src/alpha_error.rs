@@ -18,8 +18,9 @@
 //! constant is 1/6 − β(1 − α_f)/(1 − α_m): equal to C at ρ∞ = 0 and 1, 1.4 % off at ρ∞ = 0.9.
 //!
 //! **The norm: error per step, tolerance transformed.** A step is accepted when
-//! `‖e / sc‖_rms ≤ √rtol`, sc = atol + rtol·max(|q_n|, |q_{n+1}|), over the positions and the
-//! first-order tail (a controller's states; the audits stay out). Error per step with a
+//! `‖e / sc‖_rms ≤ √rtol`, sc = atol + rtol·max(|q_n|, |q_{n+1}|), over the positions (all, or
+//! the system's principal ones: [`ErrorPositions`]) and the first-order tail (a controller's
+//! states; the audits stay out). Error per step with a
 //! second-order method gives a global error ∝ (allowance)^(2/3); the allowance sc·√rtol makes
 //! that ∝ tol when rtol and atol are scaled together (Söderlind & Wang, J. Comput. Appl. Math.
 //! 185 (2006): tolerance proportionality by transforming the tolerance). Error per *unit* step
@@ -33,7 +34,7 @@
 //! positions' (the same accelerations drive both).
 //!
 //! **The step.** ε is O(h³), so h_new = h·clamp(0.9 ε^(−1/3), 0.2, 2) (with a PI term, see
-//! [`StepHistory`]), at most `max_step`. A
+//! [`StepHistory`]), at most `max_step` and below a cap after a Newton failure. A
 //! proposed growth below 25 % keeps the step, and with it the factorised iteration matrix,
 //! whose coefficients scale with h and h² (it is re-evaluated when the step changes by more
 //! than a quarter).
@@ -58,8 +59,8 @@ pub enum ErrorPositions {
     #[default]
     All,
     /// Only the system's principal positions
-    /// ([`crate::SecondOrderSystem::principal_positions`], a robot's effector): the rest is
-    /// integrated at the steps they need, its unresolved modes damped by ρ∞ as on a fixed step.
+    /// ([`crate::SecondOrderSystem::principal_positions`], a robot's effector): the rest rides
+    /// on the steps those need, its unresolved modes damped by ρ∞ as on a fixed step.
     Principal,
 }
 

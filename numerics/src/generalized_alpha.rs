@@ -18,7 +18,8 @@
 //! when the iterations a stale matrix costs have paid for a refresh, or when the step changed. A
 //! step whose Newton iteration fails even with a fresh matrix is retried at half the size; the
 //! step grows back after a few successes. With an [`ErrorControl`] the step is chosen instead
-//! by the local error estimate of [`crate::alpha_error`], and `step` is only the first one.
+//! by the local error estimate of [`crate::alpha_error`], below a cap where Newton last failed,
+//! and `step` is only the first one and the first after each restart.
 //!
 //! First-order states that ride along (a controller, energy audits) are the system's business: it
 //! updates them from the step's endpoints ([`SecondOrderSystem::end_step`]), e.g. by the trapezoidal
@@ -591,11 +592,15 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
         }
         self.rate_try = vec![0.0; dim - 2 * n];
         self.error_tail = sys.error_len().clamp(2 * n, dim) - 2 * n;
-        self.principal = sys.principal_positions();
-        if self.principal.is_empty() || self.principal.iter().any(|&i| i >= n) {
-            return Err(IntegratorError::Usage(
-                "principal positions must be some of the system's coordinates",
-            ));
+        if let Some(c) = self.opts.error_control
+            && c.positions == ErrorPositions::Principal
+        {
+            self.principal = sys.principal_positions();
+            if self.principal.is_empty() || self.principal.iter().any(|&i| i >= n) {
+                return Err(IntegratorError::Usage(
+                    "principal positions must be some of the system's coordinates",
+                ));
+            }
         }
         self.history = StepHistory::default();
         let pattern = sys.iteration_pattern();
