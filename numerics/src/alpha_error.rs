@@ -228,3 +228,40 @@ impl StepHistory {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CONTROL: ErrorControl = ErrorControl {
+        rtol: 1e-6,
+        atol: 1e-6,
+        max_step: 1.0,
+        positions: ErrorPositions::All,
+    };
+
+    /// After Newton fails at h the proposals stay below h/2 · 1.2^k however small the error and
+    /// reach h again after four accepted steps; a restart lifts the cap at once (the step after
+    /// it still keeps the no-growth rule of a rejection, then doubles where the cap would allow
+    /// 1.2).
+    #[test]
+    fn a_newton_failure_caps_the_steps_that_follow() {
+        let mut history = StepHistory::default();
+        let h = 1e-3;
+        let mut step = history.newton_failed(h);
+        assert_eq!(step, 0.5 * h);
+        let mut caps = Vec::new();
+        for k in 0..6 {
+            // An error of 1e-6 alone would double the step each time.
+            step = history.accepted(&CONTROL, step, 1e-6);
+            caps.push(step);
+            assert!(step <= 0.5 * h * 1.2f64.powi(k) * (1.0 + 1e-12), "{caps:?}");
+        }
+        assert!(caps[3] < h && caps[4] > h, "{caps:?}");
+        history.newton_failed(h);
+        history.restarted();
+        let held = history.accepted(&CONTROL, 0.5 * h, 1e-6);
+        assert_eq!(held, 0.5 * h);
+        assert_eq!(history.accepted(&CONTROL, held, 1e-6), h);
+    }
+}
