@@ -122,17 +122,16 @@ impl ErrorControl {
             &ends.qdd1[..n],
         );
         let mut sum = 0.0;
+        let mut position = |i: usize| {
+            add_scaled(&mut sum, c * (a1[i] - a0[i]), q0[i], q1[i], rtol, atol);
+        };
         let n = match ends.positions {
             Some(positions) => {
-                for &i in positions {
-                    add_scaled(&mut sum, c * (a1[i] - a0[i]), q0[i], q1[i], rtol, atol);
-                }
+                positions.iter().for_each(|&i| position(i));
                 positions.len()
             }
             None => {
-                for i in 0..n {
-                    add_scaled(&mut sum, c * (a1[i] - a0[i]), q0[i], q1[i], rtol, atol);
-                }
+                (0..n).for_each(position);
                 n
             }
         };
