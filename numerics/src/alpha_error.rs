@@ -93,6 +93,8 @@ pub(crate) struct StepEnds<'a> {
     pub before: Option<(&'a [f64], f64)>,
     /// The positions in the norm (None: all).
     pub positions: Option<&'a [usize]>,
+    /// Each tail component's factor to the positions' units (None: all 1).
+    pub tail_weights: Option<&'a [f64]>,
 }
 
 /// Accumulates (e_i / sc_i)², NaN-propagating.
@@ -145,7 +147,11 @@ impl ErrorControl {
                 }
                 None => h * (r1 - r0) / 12.0,
             };
-            add_scaled(&mut sum, e, ends.z0[i], ends.z1[i], rtol, atol);
+            let (z0, z1) = (ends.z0[i], ends.z1[i]);
+            match ends.tail_weights {
+                Some(w) => add_scaled(&mut sum, w[i] * e, w[i] * z0, w[i] * z1, rtol, atol),
+                None => add_scaled(&mut sum, e, z0, z1, rtol, atol),
+            }
         }
         (sum / (n + m).max(1) as f64).sqrt() / rtol.sqrt()
     }

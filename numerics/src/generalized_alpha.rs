@@ -123,6 +123,8 @@ pub struct GeneralizedAlpha {
     error_tail: usize,
     /// The positions in the error norm under [`ErrorPositions::Principal`].
     principal: Vec<usize>,
+    /// The system's tail weights in the norm ([`SecondOrderSystem::tail_weights`]; empty: 1).
+    tail_weights: Vec<f64>,
     history: StepHistory,
     values: Vec<f64>,
     matrix: Option<IterationMatrix>,
@@ -161,6 +163,7 @@ impl GeneralizedAlpha {
             rate_try: Vec::new(),
             error_tail: 0,
             principal: Vec::new(),
+            tail_weights: Vec::new(),
             history: StepHistory::default(),
             values: Vec::new(),
             matrix: None,
@@ -523,6 +526,7 @@ impl GeneralizedAlpha {
             before: (h_before > 0.0).then(|| (&self.dy_prev[tail], h_before)),
             positions: (control.positions == ErrorPositions::Principal)
                 .then_some(self.principal.as_slice()),
+            tail_weights: (!self.tail_weights.is_empty()).then_some(self.tail_weights.as_slice()),
         };
         control.scaled_error(self.coeff.error_constant(), h, &ends)
     }
@@ -592,6 +596,15 @@ impl<S: SecondOrderSystem + ?Sized> Stepper<S> for GeneralizedAlpha {
         }
         self.rate_try = vec![0.0; dim - 2 * n];
         self.error_tail = sys.error_len().clamp(2 * n, dim) - 2 * n;
+        self.tail_weights = sys.tail_weights();
+        if !(self.tail_weights.is_empty()
+            || self.tail_weights.len() == self.error_tail
+                && self.tail_weights.iter().all(|w| w.is_finite() && *w > 0.0))
+        {
+            return Err(IntegratorError::Usage(
+                "tail weights must be one finite positive factor per tail component in the norm",
+            ));
+        }
         if let Some(c) = self.opts.error_control
             && c.positions == ErrorPositions::Principal
         {

@@ -215,6 +215,12 @@ pub trait SecondOrderSystem: OdeSystem {
     fn residual_round_off(&self, _y: &[f64]) -> f64 {
         0.0
     }
+    /// Per tail component in the error norm ([`Self::error_len`]), the factor that converts
+    /// it to the positions' units, so that one atol means one thing: a filter state in m/s
+    /// enters as metres over the filter's time constant. Empty (the default): every factor 1.
+    fn tail_weights(&self) -> Vec<f64> {
+        Vec::new()
+    }
     /// The positions a user's quantity of interest lives in (a robot's effector): all that an
     /// error norm on [`crate::ErrorPositions::Principal`] measures. Default: every position.
     fn principal_positions(&self) -> Vec<usize> {

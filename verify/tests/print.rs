@@ -172,6 +172,36 @@ fn an_error_controlled_print_turns_its_corners() {
     );
 }
 
+/// The controller's states are measured in metres by the error norm
+/// (`Controller::state_weights`): the computed-torque's filtered velocity error by K_d/K_p and
+/// its rate by K_d/(K_p ω_f). In their own units (m/s²) against atol = 1e-5 the filter's rate
+/// set the steps: the same square on lumped lines at rtol 1e-3, atol 1e-5 on the effector's
+/// norm took 3 590 steps. Now it draws the fixed h = 1e-4 s run's largest contour error within
+/// 1 µm (measured 0.3 µm; 0.2 µm from an rtol 1e-6, atol 1e-9 run) in fewer than 1 000 steps
+/// (measured 650).
+#[test]
+fn an_error_controlled_print_measures_the_controllers_states_in_metres() {
+    use cdpr_bench::core::scenario::{ErrorNorm, IntegratorKind};
+    let mut scenario = printer_on_massive_lines("lumped", 20);
+    scenario.simulation.integrator = IntegratorKind::Implicit;
+    let print = cdpr_bench::prepare_print(&scenario, SMALL_SQUARE, None).unwrap();
+    let run =
+        |s: &Scenario| cdpr_bench::simulate_print(s, &print, &mut Observer::progress(&mut |_| {}));
+    let fixed = run(&scenario).unwrap();
+    scenario.simulation.adaptive = true;
+    (scenario.simulation.rtol, scenario.simulation.atol) = (1e-3, 1e-5);
+    scenario.simulation.error_norm = ErrorNorm::Effector;
+    let adaptive = run(&scenario).unwrap_or_else(|e| panic!("{e}"));
+    let (a, f) = (&adaptive.contour.overall, &fixed.contour.overall);
+    let steps = adaptive.run.stats.steps_accepted;
+    eprintln!(
+        "contour max {:.4e} vs {:.4e} m in {steps} steps",
+        a.max, f.max
+    );
+    assert!((a.max - f.max).abs() < 1e-6, "{a:?} against {f:?}");
+    assert!(steps < 1_000, "{steps} steps");
+}
+
 /// DOPRI5 stops at the reference's jumps too: the same 10 mm square on elastic lines at
 /// rtol 1e-5 draws the contour of an rtol 1e-9 run to 2e-11 m in its largest error and 3e-11 m
 /// in its rms (measured 4.4e-12 and 1.1e-11 m; stepping across the corners instead gave 1.0e-10

@@ -72,6 +72,10 @@ impl<const D: usize> Controller<D> for ComputedTorque<D> {
     fn state_len(&self) -> usize {
         error_states::states::<D>()
     }
+    fn state_weights(&self, out: &mut [f64]) {
+        self.errors
+            .weights::<D>(Vector::repeat(self.kd / self.kp), out);
+    }
     fn uses_reference_derivatives(&self) -> bool {
         true
     }

@@ -23,6 +23,27 @@ impl ErrorStates {
         Vector::from_fn(|k, _| states[k])
     }
 
+    /// Each state's factor to metres in an error norm (`Controller::state_weights`), by the
+    /// gain it reaches the command through: ė_f [m/s] by `velocity_time` = K_d/K_p [s] of its
+    /// axis (the position error commanding as much), ė_f' [m/s²] by K_d/(K_p ω_f) (it reaches
+    /// ė_f over the filter's time constant); σ [m s] as it is, as the PID's integral. Measured
+    /// in their own units against one atol, the filter's rate ė_f' set the steps of a printed
+    /// layer (atol 1e-4 in m/s² of an internal state). A ratio that is not finite and positive
+    /// (a controller not yet designed) leaves the factor 1.
+    pub fn weights<const D: usize>(&self, velocity_time: Vector<D>, out: &mut [f64]) {
+        let filter_time = if self.filter.is_on() {
+            1.0 / self.filter.omega
+        } else {
+            1.0
+        };
+        let usable = |w: f64| if w.is_finite() && w > 0.0 { w } else { 1.0 };
+        for k in 0..D {
+            out[k] = 1.0;
+            out[D + k] = usable(velocity_time[k]);
+            out[2 * D + k] = usable(velocity_time[k] * filter_time);
+        }
+    }
+
     /// The velocity error ė [m/s] the controller acts on: filtered, or raw when the filter is off.
     pub fn velocity_error<const D: usize>(
         &self,

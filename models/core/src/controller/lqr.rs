@@ -169,6 +169,18 @@ impl<const D: usize> Controller<D> for Lqr<D> {
     fn state_len(&self) -> usize {
         error_states::states::<D>()
     }
+    /// K_d/K_p per axis as the columns' norms of K: ‖K ė_k‖/‖K e_k‖.
+    fn state_weights(&self, out: &mut [f64]) {
+        let n = Self::DESIGN_STATES;
+        let column = |j: usize| {
+            (0..self.robot.cables())
+                .map(|i| self.gain[i * n + j].powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        let velocity_time = Vector::<D>::from_fn(|k, _| column(D + k) / column(k));
+        self.errors.weights::<D>(velocity_time, out);
+    }
     fn uses_reference_derivatives(&self) -> bool {
         true
     }

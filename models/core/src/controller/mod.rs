@@ -164,6 +164,14 @@ pub trait Controller<const D: usize>: Send + Sync + std::fmt::Debug {
         out: &mut [f64],
     );
 
+    /// Each state's factor to metres in an error norm
+    /// (`cdpr_numerics::SecondOrderSystem::tail_weights`): a state in other units (a filtered
+    /// velocity) enters as the distance it makes over its own time scale. Default: 1 (states
+    /// in metres, and integrals in m s as metres over a second).
+    fn state_weights(&self, out: &mut [f64]) {
+        out.fill(1.0);
+    }
+
     /// Whether the controller reads the reference's velocity and acceleration (feedforward);
     /// the loop skips computing them otherwise (the elastic RHS is ~15 ns: it shows).
     fn uses_reference_derivatives(&self) -> bool {
@@ -295,6 +303,9 @@ impl<const D: usize> Controller<D> for AnyController<D> {
     }
     fn measures(&self) -> Measures {
         dispatch!(self, c => Controller::<D>::measures(c))
+    }
+    fn state_weights(&self, out: &mut [f64]) {
+        dispatch!(self, c => Controller::<D>::state_weights(c, out))
     }
     #[inline]
     fn output(

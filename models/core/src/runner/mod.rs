@@ -119,7 +119,7 @@ impl From<&Scenario> for RunOptions {
                     error_control: sim.adaptive.then(|| ErrorControl {
                         rtol: sim.rtol,
                         atol: sim.atol,
-                        max_step: s.largest_implicit_step(),
+                        max_step: s.largest_adaptive_step(),
                         positions: match sim.error_norm {
                             ErrorNorm::All => ErrorPositions::All,
                             ErrorNorm::Effector => ErrorPositions::Principal,

@@ -327,7 +327,7 @@ pub struct Simulation {
     pub rho_inf: f64,
     /// Error control of the implicit method: each step's local error estimate, held within
     /// √rtol × (atol + rtol |q|), chooses the next step (numerics `alpha_error`), up to
-    /// [`Scenario::largest_implicit_step`]. Off by default: the fixed `step` (written into a
+    /// [`Scenario::largest_adaptive_step`]. Off by default: the fixed `step` (written into a
     /// run's provenance only when on, so that today's results stay byte for byte).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub adaptive: bool,
@@ -484,6 +484,15 @@ impl Scenario {
     pub fn largest_implicit_step(&self) -> f64 {
         let t = &self.trajectory;
         ((t.t2 - t.t1) / STEPS_PER_MOVE).min(1.0 / self.controller.filter)
+    }
+
+    /// The largest step of an `adaptive` implicit run [s]: the move resolved as on the fixed
+    /// path ([`STEPS_PER_MOVE`] steps over [t1, t2]). The controller's dynamics, which bound
+    /// the fixed step, are the error norm's to resolve: it measures the controller's states
+    /// (`Controller::state_weights`).
+    pub fn largest_adaptive_step(&self) -> f64 {
+        let t = &self.trajectory;
+        (t.t2 - t.t1) / STEPS_PER_MOVE
     }
 
     /// The vertical reference in force: the trajectory's `z_ref`, or the controller's default.
