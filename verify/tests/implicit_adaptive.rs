@@ -157,7 +157,7 @@ fn section_8_rows_pass_under_error_control_at_the_default_tolerance() {
 /// Error control on the effector (`error_norm = "effector"`) on the lumped paper run (5 s, N =
 /// 40, rtol 1e-5, atol 1e-6) reaches the accuracy of the fixed h = 1e-4 s run by the issue's
 /// bars — T1 min within 1e-3 N, z p2p within 1e-3 relative, the settled error within 1e-7 m
-/// (measured 3.0e-4 N, 4.5e-5, 1.3e-9 m) — in under a fifth of its steps (measured 4 658
+/// (measured 3.0e-4 N, 4.6e-5, 2.5e-9 m) — in under a fifth of its steps (measured 4 147
 /// against 51 769: the nodes' string vibrations no longer set the step), and passes every
 /// MODELS.md §8 row the fixed step passes (the high-frequency row aside, as above).
 #[test]
