@@ -22,6 +22,17 @@ impl LumpedSpatial {
         let n = self.elements;
         self.mass_matrix_into(values);
         for cable in 0..self.robot.cables() {
+            // The stored rows' projection (the same for every stored node of the cable); a free
+            // node's and the effector's rows are taken as they are (I B is B, bit for bit).
+            let stored = self.stored[cable];
+            let projection = self.row_projection(cable, 0);
+            let project = |row: usize, block: &Matrix3<f64>| {
+                if row < stored {
+                    projection * block
+                } else {
+                    *block
+                }
+            };
             for j in 0..n {
                 let blocks = match self.spring_blocks(state, cable, j) {
                     Ok(Some(blocks)) => blocks,
@@ -29,19 +40,14 @@ impl LumpedSpatial {
                     Err(AtPulley) => return false,
                 };
                 let pairs = [(j, j), (j, j + 1), (j + 1, j), (j + 1, j + 1)];
-                let project = |row: usize, block: &Matrix3<f64>| {
-                    if row < n {
-                        self.row_projection(cable, row) * block
-                    } else {
-                        *block
-                    }
-                };
                 for (k, (row, col)) in pairs.into_iter().enumerate() {
                     let projected = project(row, &blocks.position[k]);
-                    let damped = blocks.rate.map(|rate| project(row, &rate[k]));
+                    let damped = blocks.rate.as_ref().map(|rate| project(row, &rate[k]));
+                    // The block's nine entries are consecutive, row by row.
+                    let block = &mut values[self.pattern_index(cable, row, col, 0, 0)..][..9];
                     for r in 0..3 {
                         for c in 0..3 {
-                            let entry = &mut values[self.pattern_index(cable, row, col, r, c)];
+                            let entry = &mut block[3 * r + c];
                             *entry -= c_q * projected[(r, c)];
                             if let Some(damped) = &damped {
                                 *entry -= c_v * damped[(r, c)];
