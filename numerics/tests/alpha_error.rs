@@ -132,7 +132,7 @@ impl SecondOrderSystem for Pair {
 /// closed form), state [q, q', z], the filter's output in units s times the position's and
 /// weighted by `weight` in the error norm.
 struct Filtered {
-    omega: f64,
+    oscillator: Oscillator,
     lambda: f64,
     s: f64,
     weight: f64,
@@ -143,37 +143,37 @@ impl OdeSystem for Filtered {
     fn dimension(&self) -> usize {
         3
     }
-    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) {
-        dy[0] = y[1];
-        dy[1] = -self.omega * self.omega * y[0];
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        self.oscillator.rhs(t, &y[..2], &mut dy[..2]);
         dy[2] = self.lambda * (self.s * y[0] - y[2]);
     }
 }
 
+/// The oscillator's, with the filter in the tail.
 impl SecondOrderSystem for Filtered {
     fn dofs(&self) -> usize {
         1
     }
     fn iteration_pattern(&self) -> Vec<(usize, usize)> {
-        vec![(0, 0)]
+        self.oscillator.iteration_pattern()
     }
     fn begin_step(&mut self, _t: f64, y: &[f64], h: f64) {
         self.start = (h, y[0], y[2]);
     }
-    fn residual(&mut self, _t: f64, y: &[f64], qdd: &[f64], r: &mut [f64]) {
-        r[0] = qdd[0] + self.omega * self.omega * y[0];
+    fn residual(&mut self, t: f64, y: &[f64], qdd: &[f64], r: &mut [f64]) {
+        self.oscillator.residual(t, y, qdd, r);
     }
     fn iteration_matrix(
         &mut self,
-        _t: f64,
-        _y: &[f64],
-        _qdd: &[f64],
-        _c_v: f64,
+        t: f64,
+        y: &[f64],
+        qdd: &[f64],
+        c_v: f64,
         c_q: f64,
         values: &mut [f64],
     ) -> MatrixCost {
-        values[0] = 1.0 + c_q * self.omega * self.omega;
-        MatrixCost::default()
+        self.oscillator
+            .iteration_matrix(t, y, qdd, c_v, c_q, values)
     }
     fn end_step(&mut self, _t: f64, y: &mut [f64]) {
         let (h, q0, z0) = self.start;
@@ -285,7 +285,7 @@ fn a_tail_weight_converts_a_state_to_the_positions_units() {
     let (t_end, tol) = (3.0, 1e-6);
     let run = |s: f64, weight: f64| {
         let mut sys = Filtered {
-            omega: 2.0,
+            oscillator: Oscillator { omega: 2.0 },
             lambda: 40.0,
             s,
             weight,
