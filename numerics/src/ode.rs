@@ -216,8 +216,9 @@ pub trait SecondOrderSystem: OdeSystem {
         0.0
     }
     /// Per tail component in the error norm ([`Self::error_len`]), the factor that converts
-    /// it to the positions' units, so that one atol means one thing: a filter state in m/s
-    /// enters as metres over the filter's time constant. Empty (the default): every factor 1.
+    /// it to the positions' units, so that one atol means one thing (a robot's filtered
+    /// velocity in m/s enters as the position error its controller treats alike). Empty (the
+    /// default): every factor 1.
     fn tail_weights(&self) -> Vec<f64> {
         Vec::new()
     }

@@ -166,8 +166,8 @@ pub trait Controller<const D: usize>: Send + Sync + std::fmt::Debug {
 
     /// Each state's factor to metres in an error norm
     /// (`cdpr_numerics::SecondOrderSystem::tail_weights`): a state in other units (a filtered
-    /// velocity) enters as the distance it makes over its own time scale. Default: 1 (states
-    /// in metres, and integrals in m s as metres over a second).
+    /// velocity) enters as the position error that commands as much. Default: 1 (states in
+    /// metres, and integrals in m s as they are).
     fn state_weights(&self, out: &mut [f64]) {
         out.fill(1.0);
     }
