@@ -3,8 +3,9 @@
 //! Hangprinter-like robot with elastic cables under computed-torque — the wrench-feasibility
 //! check every millisecond and the run (sampled at the end only: integration, reference and
 //! controller), and the same layer on the massive lines (lumped N = 20, FE N = 10; the printer
-//! example's damped line) on the implicit path, sampled every millisecond with the contour
-//! error measured, as `cargo xtask print` runs it but for the files. Steps, RHS (residual)
+//! example's damped line) on the implicit path, fixed-step and (lumped) error-controlled,
+//! sampled every millisecond with the contour error measured, as `cargo xtask print` runs it
+//! but for the files. Steps, RHS (residual)
 //! evaluations and iteration matrices of each run are printed once.
 
 use cdpr_bench::core::closed_loop::{ClosedLoop, Path as LoopPath};
@@ -99,8 +100,17 @@ fn cube_first_layer_massive(c: &mut Criterion) {
     let mut group = c.benchmark_group("printing/cube_layer1_hangprinter");
     group.sample_size(10);
     let text = std::fs::read_to_string(data("cube.gcode")).unwrap();
-    for (kind, elements) in [("lumped", 20), ("fe", 10)] {
-        let scenario = on_massive_lines(kind, elements);
+    // The lumped lines also under error control on the effector (rtol 1e-3, atol 1e-5: the
+    // printed contour of a converged run within 0.1 µm, docs/numerics.md "A printed layer").
+    let mut adaptive = on_massive_lines("lumped", 20);
+    adaptive.simulation.adaptive = true;
+    (adaptive.simulation.rtol, adaptive.simulation.atol) = (1e-3, 1e-5);
+    adaptive.simulation.error_norm = cdpr_bench::core::scenario::ErrorNorm::Effector;
+    for (kind, elements, scenario) in [
+        ("lumped", 20, on_massive_lines("lumped", 20)),
+        ("fe", 10, on_massive_lines("fe", 10)),
+        ("lumped_adaptive_effector_", 20, adaptive),
+    ] {
         let print = cdpr_bench::prepare_print(&scenario, &text, Some(1..=1)).unwrap();
         let go = || {
             let mut quiet = |_: f64| {};
