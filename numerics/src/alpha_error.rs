@@ -147,11 +147,9 @@ impl ErrorControl {
                 }
                 None => h * (r1 - r0) / 12.0,
             };
-            let (z0, z1) = (ends.z0[i], ends.z1[i]);
-            match ends.tail_weights {
-                Some(w) => add_scaled(&mut sum, w[i] * e, w[i] * z0, w[i] * z1, rtol, atol),
-                None => add_scaled(&mut sum, e, z0, z1, rtol, atol),
-            }
+            // A weight of 1 multiplies exactly: the unweighted norm's bits.
+            let w = ends.tail_weights.map_or(1.0, |w| w[i]);
+            add_scaled(&mut sum, w * e, w * ends.z0[i], w * ends.z1[i], rtol, atol);
         }
         (sum / (n + m).max(1) as f64).sqrt() / rtol.sqrt()
     }

@@ -334,17 +334,13 @@ impl<M: CableModel<D>, const D: usize> SecondOrderSystem for ClosedLoop<M, D> {
     }
 
     /// 1 for the model's own tail, the controller's [`Controller::state_weights`] for its
-    /// states; empty when all are 1.
+    /// states.
     fn tail_weights(&self) -> Vec<f64> {
         let tail = self.dynamic_len() - 2 * SecondOrderSystem::dofs(self);
-        let c = self.controller_len();
         let mut weights = vec![1.0; tail];
-        self.controller.state_weights(&mut weights[tail - c..]);
-        if weights.iter().all(|&w| w == 1.0) {
-            Vec::new()
-        } else {
-            weights
-        }
+        self.controller
+            .state_weights(&mut weights[tail - self.controller_len()..]);
+        weights
     }
 
     fn residual_round_off(&self, y: &[f64]) -> f64 {

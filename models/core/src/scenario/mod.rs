@@ -482,8 +482,8 @@ impl Scenario {
     /// dynamics, the derivative filter's time constant 1/N_f (paper: 1.85 ms; the paper runs use
     /// 1e-4 s). A step of 1 s was accepted before and returned T1 min 76.1 N instead of 91.8 N.
     pub fn largest_implicit_step(&self) -> f64 {
-        let t = &self.trajectory;
-        ((t.t2 - t.t1) / STEPS_PER_MOVE).min(1.0 / self.controller.filter)
+        self.largest_adaptive_step()
+            .min(1.0 / self.controller.filter)
     }
 
     /// The largest step of an `adaptive` implicit run [s]: the move resolved as on the fixed
