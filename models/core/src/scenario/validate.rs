@@ -156,18 +156,33 @@ impl Scenario {
         }
         positive("simulation.step", s.step)?;
         if s.integrator == IntegratorKind::Implicit {
-            let largest = self.largest_implicit_step();
+            let span = self.trajectory.t2 - self.trajectory.t1;
+            // An adaptive run's `step` is only its first: the error control measures the
+            // controller's states, so the filter bounds the fixed step alone.
+            let (largest, rule) = if s.adaptive {
+                (
+                    self.largest_adaptive_step(),
+                    format!(
+                        "an adaptive run's first step must resolve the move (at least \
+                         {STEPS_PER_MOVE} steps over t2 − t1 = {span} s)"
+                    ),
+                )
+            } else {
+                (
+                    self.largest_implicit_step(),
+                    format!(
+                        "the fixed step must resolve the move (at least {STEPS_PER_MOVE} steps \
+                         over t2 − t1 = {span} s) and the PID's derivative filter \
+                         (h ≤ 1/filter = {:e} s)",
+                        1.0 / self.controller.filter
+                    ),
+                )
+            };
             if s.step > largest {
                 return Err(out_of_range(
                     "simulation.step",
                     s.step,
-                    format!(
-                        "≤ {largest:e} s for this scenario: the fixed step must resolve the move \
-                         (at least {STEPS_PER_MOVE} steps over t2 − t1 = {} s) and the PID's \
-                         derivative filter (h ≤ 1/filter = {:e} s)",
-                        self.trajectory.t2 - self.trajectory.t1,
-                        1.0 / self.controller.filter
-                    ),
+                    format!("≤ {largest:e} s for this scenario: {rule}"),
                 ));
             }
         }
