@@ -9,7 +9,7 @@ use cdpr_numerics::{
 };
 use proptest::prelude::*;
 
-mod common;
+use crate::common;
 use common::Kepler;
 
 /// q'' + ω² q = 0, state [q, q'].

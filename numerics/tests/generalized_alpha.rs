@@ -7,7 +7,7 @@ use cdpr_numerics::{
 };
 use proptest::prelude::*;
 
-mod common;
+use crate::common;
 use common::Kepler;
 
 /// m q'' + k q = 0 with a tail z' = q (trapezoidal), state [q, q', z].

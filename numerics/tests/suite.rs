@@ -1,8 +1,11 @@
-//! The numerical methods tests as one test binary: each file beside this one is a module here, so they
-//! compile and link once and share the cores. `Cargo.toml` turns off the discovery of each file as its own test.
+//! The numerical methods tests as one test binary: each file beside this one is a module here,
+//! so they compile and link once and share the cores. `Cargo.toml` turns off the discovery of
+//! each file as its own test.
 
 #[path = "alpha_error.rs"]
 mod alpha_error;
+/// What the modules share (tests/common/mod.rs), compiled once.
+mod common;
 #[path = "differences.rs"]
 mod differences;
 #[path = "dopri5.rs"]

@@ -11,7 +11,7 @@
 //!   and the discrete-string closed forms;
 //! - a pendulum: a 1 kg mass on the cable released from 0.3 rad, MoorDyn against the lumped chain.
 
-mod common;
+use crate::common;
 
 use cdpr_bench::core::Vector2;
 use cdpr_bench::fe::element::Material;

@@ -17,7 +17,7 @@
 //! against MoorDyn's (the effector held), and a weightless robot's taut lines' transverse modes
 //! against the discrete string's closed form.
 
-mod common;
+use crate::common;
 
 use cdpr_bench::core::model::{CableModel, PoseRule};
 use cdpr_bench::core::robot::distribution::{DistributionMethod, TensionBox, distribute};

@@ -2,6 +2,8 @@
 //! suite compiles and links once, and its tests share the cores instead of running binary after
 //! binary. `Cargo.toml` turns off the discovery of each file as its own test.
 
+/// What the modules share (tests/common/mod.rs), compiled once.
+mod common;
 #[path = "control.rs"]
 mod control;
 #[path = "equilibrium_irvine.rs"]

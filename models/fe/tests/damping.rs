@@ -3,7 +3,7 @@
 //! them: a wrong sign, a missing l-row term or the wrong (1 + ε) factor breaks the balance by an
 //! amount of the order of D itself.
 
-mod common;
+use crate::common;
 
 use cdpr_core::channel::Channel;
 use cdpr_core::model::{CableModel, SplitRule};

@@ -3,7 +3,7 @@
 //! limit is the standard truss, steady pay-out is a steady state, and the elements only pull.
 //! T and U are coded in `common` from FE.3–FE.4 (velocity-field quadrature), not from the kernel.
 
-mod common;
+use crate::common;
 
 use cdpr_core::Vector2;
 use cdpr_core::model::{CableModel, SplitRule};

@@ -6,7 +6,7 @@
 //! d/dt (E_span + E_P) = Σ Q_l,i l_i', Q_l = (M q'' − F)_l minus the stored cable's
 //! Lagrange term μ (L0 − l) l'' − ½ μ l'², a balance the model's assembly does not contain.
 
-mod common;
+use crate::common;
 
 use cdpr_core::model::{CableModel, SplitRule};
 use cdpr_fe::{Fe, FeMass, FeStored};

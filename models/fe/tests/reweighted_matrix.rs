@@ -4,7 +4,7 @@
 //! Swept over states near equilibria (disturbed positions and velocities), both mass variants,
 //! axial damping on and off, and pairs of step sizes across three decades.
 
-mod common;
+use crate::common;
 
 use cdpr_core::model::CableModel;
 use cdpr_core::scenario::Scenario;

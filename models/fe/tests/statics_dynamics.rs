@@ -2,7 +2,7 @@
 //! against the continuum catenary table of FE.8.3, the energy identity dE/dt = Σ T_i ρ_i' in time,
 //! and the linearised open-loop frequencies of FE.10.2.
 
-mod common;
+use crate::common;
 
 use cdpr_core::channel::Channel;
 use cdpr_core::closed_loop::ClosedLoop;

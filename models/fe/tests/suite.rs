@@ -3,6 +3,8 @@
 //! as its own test; the allocation test stays a binary of its own, as it installs a counting
 //! global allocator.
 
+/// What the modules share (tests/common/mod.rs), compiled once.
+mod common;
 #[path = "damping.rs"]
 mod damping;
 #[path = "lagrangian.rs"]
