@@ -293,20 +293,13 @@ fn csv_without_wall(text: &str) -> String {
     kept
 }
 
+/// A CSV line's fields (a quoted field may hold commas).
 fn csv_fields(line: &str) -> Vec<&str> {
-    let (mut fields, mut start, mut quoted) = (Vec::new(), 0, false);
-    for (i, c) in line.char_indices() {
-        match c {
-            '"' => quoted = !quoted,
-            ',' if !quoted => {
-                fields.push(&line[start..i]);
-                start = i + 1;
-            }
-            _ => {}
-        }
-    }
-    fields.push(&line[start..]);
-    fields
+    let mut quoted = false;
+    split_unshielded(line, ',', |c| {
+        quoted ^= c == '"';
+        quoted
+    })
 }
 
 /// A Markdown file with its tables' [`WALL_COLUMNS`] emptied, a study's wall time and cores cut
@@ -352,14 +345,28 @@ fn markdown_without_wall(text: &str) -> String {
 
 /// A table row split at its unescaped `|` (a cell may hold `\|`).
 fn markdown_cells(line: &str) -> Vec<&str> {
-    let (mut cells, mut start, mut escaped) = (Vec::new(), 0, false);
+    let mut escaped = false;
+    split_unshielded(line, '|', |c| {
+        let shielded = escaped;
+        escaped = c == '\\' && !escaped;
+        shielded
+    })
+}
+
+/// `line` split at each `separator` that `shielded` does not protect; `shielded` sees every
+/// character in turn and says whether it is protected.
+fn split_unshielded(
+    line: &str,
+    separator: char,
+    mut shielded: impl FnMut(char) -> bool,
+) -> Vec<&str> {
+    let (mut parts, mut start) = (Vec::new(), 0);
     for (i, c) in line.char_indices() {
-        if c == '|' && !escaped {
-            cells.push(&line[start..i]);
+        if !shielded(c) && c == separator {
+            parts.push(&line[start..i]);
             start = i + 1;
         }
-        escaped = c == '\\' && !escaped;
     }
-    cells.push(&line[start..]);
-    cells
+    parts.push(&line[start..]);
+    parts
 }
