@@ -282,15 +282,20 @@ fn csv_without_wall(text: &str) -> String {
     let Some(wall) = csv_fields(header).iter().position(|f| *f == "wall_s") else {
         return text.to_owned();
     };
-    let mut kept = String::new();
-    for line in std::iter::once(header).chain(lines) {
-        let mut fields = csv_fields(line);
-        if let Some(f) = fields.get_mut(wall) {
-            *f = "";
+    std::iter::once(header)
+        .chain(lines)
+        .map(|line| blanked(csv_fields(line), &[wall], ","))
+        .collect()
+}
+
+/// `parts` joined by `separator` into a line, with those at `columns` emptied.
+fn blanked(mut parts: Vec<&str>, columns: &[usize], separator: &str) -> String {
+    for &i in columns {
+        if let Some(part) = parts.get_mut(i) {
+            *part = "";
         }
-        kept += &(fields.join(",") + "\n");
     }
-    kept
+    parts.join(separator) + "\n"
 }
 
 /// A CSV line's fields (a quoted field may hold commas).
@@ -325,20 +330,17 @@ fn markdown_without_wall(text: &str) -> String {
             kept += &(line.to_owned() + "\n");
             continue;
         }
-        let mut cells = markdown_cells(line);
-        if !in_table {
+        let cells = markdown_cells(line);
+        if in_table {
+            kept += &blanked(cells, &wall, "|");
+        } else {
+            // The header row names the columns to empty in the rows below it.
             in_table = true;
             wall = (0..cells.len())
                 .filter(|&i| WALL_COLUMNS.contains(&cells[i].trim()))
                 .collect();
-        } else {
-            for &i in &wall {
-                if let Some(c) = cells.get_mut(i) {
-                    *c = "";
-                }
-            }
+            kept += &blanked(cells, &[], "|");
         }
-        kept += &(cells.join("|") + "\n");
     }
     kept
 }

@@ -156,23 +156,22 @@ impl Scenario {
         }
         positive("simulation.step", s.step)?;
         if s.integrator == IntegratorKind::Implicit {
-            let span = self.trajectory.t2 - self.trajectory.t1;
+            let the_move = format!(
+                "resolve the move (at least {STEPS_PER_MOVE} steps over t2 − t1 = {} s)",
+                self.trajectory.t2 - self.trajectory.t1
+            );
             // An adaptive run's `step` is only its first: the error control measures the
             // controller's states, so the filter bounds the fixed step alone.
             let (largest, rule) = if s.adaptive {
                 (
                     self.largest_adaptive_step(),
-                    format!(
-                        "an adaptive run's first step must resolve the move (at least \
-                         {STEPS_PER_MOVE} steps over t2 − t1 = {span} s)"
-                    ),
+                    format!("an adaptive run's first step must {the_move}"),
                 )
             } else {
                 (
                     self.largest_implicit_step(),
                     format!(
-                        "the fixed step must resolve the move (at least {STEPS_PER_MOVE} steps \
-                         over t2 − t1 = {span} s) and the PID's derivative filter \
+                        "the fixed step must {the_move} and the PID's derivative filter \
                          (h ≤ 1/filter = {:e} s)",
                         1.0 / self.controller.filter
                     ),
