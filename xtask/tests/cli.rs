@@ -342,35 +342,27 @@ fn modes_takes_the_controller() {
     );
 }
 
-/// `shaping` runs every shaper on every model over the frequency-error sweep (a short record,
-/// for time) and writes the table, the CSV (7 shapers × 3 models × 17 errors) and a figure per
-/// model; at the design frequency ZV's analytic residual is 0 and every simulated residual is
-/// below the unshaped run's.
+/// `shaping` refuses a scenario it cannot run before any of its runs, naming the key and
+/// writing nothing. Its study itself (`cdpr_studies::shaping::compute` and the same writer) is
+/// the report's shaping section, checked in report.rs on the report's own run.
 #[test]
-fn shaping_writes_the_study() {
+fn shaping_refuses_a_bad_scenario_before_work() {
     let dir = TempDir::new("shaping");
-    let out = run_short(&dir, "shaping", 2.3);
-    let csv = std::fs::read_to_string(out.join("shaping.csv")).unwrap();
-    let rows: Vec<Vec<&str>> = csv
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').collect())
-        .collect();
-    assert_eq!(rows.len(), 7 * 3 * 17);
-    for r in &rows {
-        let residual: f64 = r[6].parse().unwrap();
-        assert!(residual.is_finite() && residual > 0.0, "{r:?}");
-        if r[1] == "zv" && r[2] == "0" {
-            let v: f64 = r[7].parse().unwrap();
-            assert!(v < 1e-9, "ZV at its design: V = {v} %");
-        }
-        if r[2] == "0" {
-            assert!(residual < 100.0, "{r:?}");
-        }
-    }
-    let md = std::fs::read_to_string(out.join("shaping.md")).unwrap();
-    assert!(md.contains("| 2hump-ei | lumped |") && md.contains("What limits shaping"));
-    for model in ["elastic", "lumped", "fe"] {
-        assert!(out.join(format!("shaping_{model}.png")).exists());
-    }
+    let scenario = dir.join("bad.toml");
+    std::fs::write(&scenario, "[simulation]\nt_final = -1.0\n").unwrap();
+    let out = dir.join("out");
+    let output = xtask()
+        .args(["shaping", "--scenario"])
+        .arg(&scenario)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success());
+    assert!(
+        stderr.contains("t_final") && stderr.contains("-1"),
+        "{stderr}"
+    );
+    assert!(!out.join("shaping.csv").exists());
 }
