@@ -12,7 +12,7 @@ pub struct SolveCost {
     pub nonzeros: usize,
     pub chain: usize,
     pub border: usize,
-    /// The sweeps run by rows in pairs ([`lanes`]): a link is a multiply-add in a register.
+    /// The sweeps run by rows in pairs ([`lanes`](super::lanes)): a link is a multiply-add in a register.
     pub paired: bool,
 }
 

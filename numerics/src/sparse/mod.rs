@@ -133,7 +133,7 @@ impl IterationMatrix {
     }
 
     /// Factorisations of the layout in use that chose their pivots (faer's); the others reused
-    /// the last pivot sequence (see [`Factors::refactor`]).
+    /// the last pivot sequence (see [`Factors::refactor`](factors::Factors::refactor)).
     pub fn pivotings(&self) -> u64 {
         self.layout().pivotings
     }

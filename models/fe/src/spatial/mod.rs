@@ -44,7 +44,7 @@ pub struct FeSpatial {
     coefficients: Vec<MassCoefficients>,
     stored_coefficients: MassCoefficients,
     system: StarSystem,
-    /// The implicit residual's span element rows ([`lanes`]).
+    /// The implicit residual's span element rows ([`lanes`](self::lanes)).
     rows: lanes::StarRows,
     /// Accelerations of the free nodes (cable-major) and of (l_i, ρ_i), per solve.
     node_accelerations: Vec<Vector3<f64>>,

@@ -7,16 +7,23 @@
 //! from the file (never all in memory), so a sweep, its shards merged, and a resumed sweep give
 //! the same bytes but for `wall_s`.
 
+mod files;
+mod merge;
+mod table;
+
+pub use files::{DirLock, LOCK, write_atomic};
+pub use merge::merge;
+
 use crate::error::SweepError;
 use crate::grid::Grid;
 use crate::record::Record;
 use serde::{Deserialize, Serialize};
-use serde_json::{Map, Value};
-use std::collections::BTreeSet;
+use serde_json::Value;
 use std::fs::{File, OpenOptions};
-use std::io::{BufRead, BufReader, BufWriter, Read, Seek, SeekFrom, Write};
+use std::io::{BufRead, BufReader, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
+use table::write_csv;
 
 /// The records file of a sweep directory.
 pub const RESULTS: &str = "results.jsonl";
@@ -373,187 +380,6 @@ fn write_sorted(out: &Path, scans: &[Scan], stop: Option<&AtomicBool>) -> Result
     write_csv(out, stop)
 }
 
-/// `out/results.csv` from `out/results.jsonl` (in point order): two passes, one for the columns
-/// (the union over the records), one for the rows.
-fn write_csv(out: &Path, stop: Option<&AtomicBool>) -> Result<(), SweepError> {
-    let path = out.join(RESULTS);
-    let records = |each: &mut dyn FnMut(Record) -> std::io::Result<()>| -> Result<(), SweepError> {
-        let file = File::open(&path).map_err(|e| SweepError::io(&path, e))?;
-        for (k, line) in BufReader::new(file).lines().enumerate().skip(1) {
-            if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
-                return Err(SweepError::io(
-                    &path,
-                    std::io::Error::new(std::io::ErrorKind::Interrupted, "interrupted"),
-                ));
-            }
-            let line = line.map_err(|e| SweepError::io(&path, e))?;
-            let record: Record = serde_json::from_str(&line)
-                .map_err(|e| results_error(&path, format!("line {}: {e}", k + 1)))?;
-            each(record).map_err(|e| SweepError::io(&path, e))?;
-        }
-        Ok(())
-    };
-    let mut params = BTreeSet::new();
-    let mut metrics = BTreeSet::new();
-    records(&mut |r| {
-        params.extend(r.params.keys().cloned());
-        metrics.extend(flatten(&r).into_iter().map(|(k, _)| k));
-        Ok(())
-    })?;
-    let csv_path = out.join(RESULTS_CSV);
-    let mut rows: Vec<u8> = Vec::new();
-    let mut head = String::from("point,status");
-    for p in &params {
-        head.push(',');
-        head.push_str(&quote(p));
-    }
-    head.push_str(",t_reached");
-    for m in &metrics {
-        head.push(',');
-        head.push_str(&quote(m));
-    }
-    head.push_str(",error,wall_s\n");
-    // The rows go through a temporary file of their own: a study's table can be larger than
-    // memory, and the header must come first.
-    let tmp = out.join(format!(".{RESULTS_CSV}.rows-{}", std::process::id()));
-    {
-        let file = File::create(&tmp).map_err(|e| SweepError::io(&tmp, e))?;
-        let mut w = BufWriter::with_capacity(1 << 20, file);
-        records(&mut |r| {
-            rows.clear();
-            row(&r, &params, &metrics, &mut rows);
-            w.write_all(&rows)
-        })?;
-        w.flush().map_err(|e| SweepError::io(&tmp, e))?;
-    }
-    let result = write_atomic(&csv_path, |w| {
-        w.write_all(head.as_bytes())?;
-        std::io::copy(&mut File::open(&tmp)?, w)?;
-        Ok(())
-    });
-    let _ = std::fs::remove_file(&tmp);
-    result
-}
-
-/// One CSV row: point, status, the parameters, t_reached, every metric (nested keys dotted,
-/// lists as JSON), error, wall_s.
-fn row(r: &Record, params: &BTreeSet<String>, metrics: &BTreeSet<String>, out: &mut Vec<u8>) {
-    use std::io::Write as _;
-    let flat: Map<String, Value> = flatten(r).into_iter().collect();
-    let _ = write!(out, "{},{}", r.point, r.status);
-    for p in params {
-        let _ = write!(out, ",{}", cell(r.params.get(p)));
-    }
-    let _ = write!(out, ",{}", r.t_reached);
-    for m in metrics {
-        let _ = write!(out, ",{}", cell(flat.get(m)));
-    }
-    let _ = writeln!(
-        out,
-        ",{},{}",
-        quote(r.error.as_deref().unwrap_or("")),
-        r.wall_s
-    );
-}
-
-/// Combines the shards' results files into `out`: one grid (equal headers), each record checked
-/// against it, each point once (a point recorded twice must agree but for `wall_s`).
-pub fn merge(
-    inputs: &[PathBuf],
-    out: &Path,
-    stop: Option<&AtomicBool>,
-) -> Result<(Header, usize), SweepError> {
-    if inputs.is_empty() {
-        return Err(results_error(
-            out,
-            "--merge needs at least one results file".into(),
-        ));
-    }
-    std::fs::create_dir_all(out).map_err(|e| SweepError::io(out, e))?;
-    let _lock = DirLock::acquire(out, "merge")?;
-    let mut scans = scan_inputs(inputs)?;
-    let owner = keep_each_point_once(&mut scans)?;
-    let header = scans[0].header.clone();
-    let n = owner.iter().filter(|o| o.is_some()).count();
-    write_sorted(out, &scans, stop)?;
-    Ok((header, n))
-}
-
-/// Each input (a results file, or a directory holding one) scanned; all must be of one grid.
-fn scan_inputs(inputs: &[PathBuf]) -> Result<Vec<Scan>, SweepError> {
-    let mut scans: Vec<Scan> = Vec::new();
-    for dir in inputs {
-        let path = if dir.is_dir() {
-            dir.join(RESULTS)
-        } else {
-            dir.clone()
-        };
-        let scan = scan(&path, None)?;
-        if let Some(first) = scans.first()
-            && first.header != scan.header
-        {
-            return Err(results_error(
-                &path,
-                format!(
-                    "is of another grid than {} (digest {} vs {})",
-                    first.path.display(),
-                    scan.header.grid,
-                    first.header.grid
-                ),
-            ));
-        }
-        scans.push(scan);
-    }
-    Ok(scans)
-}
-
-/// Each point once: a later input's record of a point already seen must agree with it, and is
-/// dropped from that input's entries. Returns each point's owner (input, entry).
-fn keep_each_point_once(scans: &mut [Scan]) -> Result<Vec<Option<(usize, Entry)>>, SweepError> {
-    let points = scans[0].header.points;
-    let mut owner: Vec<Option<(usize, Entry)>> = vec![None; points];
-    let mut files: Vec<Option<File>> = (0..scans.len()).map(|_| None).collect();
-    for k in 0..scans.len() {
-        let mut kept = Vec::new();
-        for entry in std::mem::take(&mut scans[k].entries) {
-            match owner[entry.point] {
-                None => {
-                    owner[entry.point] = Some((k, entry));
-                    kept.push(entry);
-                }
-                Some((j, first)) => {
-                    let a = read_entry(&scans[j], &mut files[j], &first)?;
-                    let b = read_entry(&scans[k], &mut files[k], &entry)?;
-                    if !same_results(&a, &b) {
-                        return Err(results_error(
-                            &scans[k].path,
-                            format!(
-                                "point {} is recorded differently in {} (line {})",
-                                entry.point,
-                                scans[j].path.display(),
-                                first.line
-                            ),
-                        ));
-                    }
-                }
-            }
-        }
-        scans[k].entries = kept;
-    }
-    Ok(owner)
-}
-
-/// The record of `entry` in `scan`'s file (opened into `file` on first use).
-fn read_entry(scan: &Scan, file: &mut Option<File>, entry: &Entry) -> Result<Record, SweepError> {
-    let path = &scan.path;
-    let file = match file {
-        Some(f) => f,
-        slot => slot.insert(File::open(path).map_err(|e| SweepError::io(path, e))?),
-    };
-    serde_json::from_str(&read_line(file, path, entry)?)
-        .map_err(|err| results_error(path, format!("line {}: {err}", entry.line)))
-}
-
 /// Every record of a results file, checked, in file order (held in memory: for callers that
 /// want them all, like the Python module).
 pub fn read_records(path: &Path) -> Result<(Header, Vec<Record>), SweepError> {
@@ -587,142 +413,4 @@ pub fn write_records(out: &Path, grid: &Grid, records: &[Record]) -> Result<(), 
     // Checked as any results file is (points in range, parameters, duplicates), then sorted.
     let scan = scan(&path, Some(grid))?;
     write_sorted(out, &[scan], None)
-}
-
-fn flatten(r: &Record) -> Vec<(String, Value)> {
-    fn walk(prefix: &str, v: &Value, out: &mut Vec<(String, Value)>) {
-        match v {
-            Value::Object(m) => {
-                for (k, v) in m {
-                    let key = if prefix.is_empty() {
-                        k.clone()
-                    } else {
-                        format!("{prefix}.{k}")
-                    };
-                    walk(&key, v, out);
-                }
-            }
-            v => out.push((prefix.to_string(), v.clone())),
-        }
-    }
-    let mut out = Vec::new();
-    walk("", &Value::Object(r.metrics.clone()), &mut out);
-    out
-}
-
-fn cell(v: Option<&Value>) -> String {
-    match v {
-        None | Some(Value::Null) => String::new(),
-        Some(Value::String(s)) => quote(s),
-        Some(Value::Number(n)) => n.to_string(),
-        Some(Value::Bool(b)) => b.to_string(),
-        Some(other) => quote(&other.to_string()),
-    }
-}
-
-/// RFC 4180 quoting where needed.
-fn quote(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
-/// Writes `path` through `fill` into a temporary file in the same directory, synced, then
-/// renamed into place; a failure removes the temporary file and leaves `path` as it was.
-pub fn write_atomic(
-    path: &Path,
-    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> Result<(), SweepError> {
-    let name = path.file_name().unwrap_or_default().to_string_lossy();
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let write = || -> std::io::Result<()> {
-        let mut w = BufWriter::with_capacity(1 << 20, File::create(&tmp)?);
-        fill(&mut w)?;
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        std::fs::rename(&tmp, path)
-    };
-    write().map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        SweepError::io(path, e)
-    })
-}
-
-/// The lock file of an output directory.
-pub const LOCK: &str = ".cdpr-lock";
-
-/// An advisory lock on an output directory, held while a run writes there: a second sweep,
-/// merge or simulate into the same directory is refused before it starts, naming the holder
-/// (two writers lost or mixed each other's files). The lock file is removed when the lock is
-/// dropped, and the OS releases the lock of a process that dies.
-pub struct DirLock {
-    file: File,
-    path: PathBuf,
-}
-
-impl DirLock {
-    /// Takes the lock of `dir` for `what` (e.g. "sweep shard 0/2"), or says who holds it.
-    pub fn acquire(dir: &Path, what: &str) -> Result<Self, SweepError> {
-        let path = dir.join(LOCK);
-        let io = |e| SweepError::io(&path, e);
-        loop {
-            let mut file = OpenOptions::new()
-                .read(true)
-                .write(true)
-                .create(true)
-                .truncate(false)
-                .open(&path)
-                .map_err(io)?;
-            match file.try_lock() {
-                Ok(()) => {}
-                Err(std::fs::TryLockError::WouldBlock) => {
-                    let mut holder = String::new();
-                    let _ = file.read_to_string(&mut holder);
-                    return Err(SweepError::Busy {
-                        dir: dir.display().to_string(),
-                        holder: holder.trim().to_string(),
-                    });
-                }
-                Err(std::fs::TryLockError::Error(e)) => return Err(io(e)),
-            }
-            // The holder before us may have removed the file between our open and our lock:
-            // then we hold a lock nobody else can see; take the lock of the file at the path.
-            if !same_file(&file, &path) {
-                continue;
-            }
-            file.set_len(0)
-                .and_then(|_| {
-                    file.write_all(format!("{what}, pid {}", std::process::id()).as_bytes())
-                })
-                .map_err(io)?;
-            return Ok(Self { file, path });
-        }
-    }
-}
-
-impl Drop for DirLock {
-    /// Removes the lock file while still holding the lock (see [`DirLock::acquire`]).
-    fn drop(&mut self) {
-        if same_file(&self.file, &self.path) {
-            let _ = std::fs::remove_file(&self.path);
-        }
-    }
-}
-
-/// Whether `path` still names the open `file`.
-fn same_file(file: &File, path: &Path) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        match (file.metadata(), std::fs::metadata(path)) {
-            (Ok(a), Ok(b)) => a.ino() == b.ino() && a.dev() == b.dev(),
-            _ => false,
-        }
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = (file, path);
-        true
-    }
 }
