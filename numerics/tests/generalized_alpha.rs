@@ -489,3 +489,90 @@ fn stepper_view_and_step_underflow() {
     );
     assert_eq!(ga.time(), 0.0, "no step was taken");
 }
+
+/// m q'' + k q = 0 that records, for every attempted step, its start (q_n, q'_n, h) and the q
+/// at which Newton first evaluates the residual (the predictor's), and whose residual is NaN
+/// once, at the first attempt to step past `trap` [s]: a Newton failure.
+struct Spy {
+    m: f64,
+    k: f64,
+    trap: f64,
+    failed: Option<usize>,
+    attempts: Vec<(f64, f64, f64, Option<f64>)>,
+}
+
+impl OdeSystem for Spy {
+    fn dimension(&self) -> usize {
+        2
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) {
+        dy[0] = y[1];
+        dy[1] = -self.k / self.m * y[0];
+    }
+}
+
+impl SecondOrderSystem for Spy {
+    fn dofs(&self) -> usize {
+        1
+    }
+    fn iteration_pattern(&self) -> Vec<(usize, usize)> {
+        vec![(0, 0)]
+    }
+    fn begin_step(&mut self, _t: f64, y: &[f64], h: f64) {
+        self.attempts.push((y[0], y[1], h, None));
+    }
+    fn residual(&mut self, t: f64, y: &[f64], qdd: &[f64], r: &mut [f64]) {
+        self.attempts.last_mut().unwrap().3.get_or_insert(y[0]);
+        r[0] = self.m * qdd[0] + self.k * y[0];
+        if t > self.trap && self.failed.is_none() {
+            self.failed = Some(self.attempts.len() - 1);
+            r[0] = f64::NAN;
+        }
+    }
+    fn iteration_matrix(
+        &mut self,
+        _t: f64,
+        _y: &[f64],
+        _qdd: &[f64],
+        _c_v: f64,
+        c_q: f64,
+        values: &mut [f64],
+    ) -> MatrixCost {
+        values[0] = self.m + c_q * self.k;
+        MatrixCost::default()
+    }
+    fn end_step(&mut self, _t: f64, _y: &mut [f64]) {}
+    fn tail_rate(&mut self, _t: f64, _y: &[f64], _out: &mut [f64]) {}
+}
+
+/// After a Newton failure, Newton starts the next 30 accepted steps from the positions
+/// q_n + h q'_n (to round-off: 1e-14 against q ~ 1); before the failure and after those steps
+/// from the extrapolated accelerations, which move q by a further ~h² q''/2 ≥ 1.6e-6 here
+/// (q = cos 2t over [0, 0.3] s, h = 1e-3 s), so a predictor that never switches, or never
+/// switches back, fails the test.
+#[test]
+fn after_a_newton_failure_newton_starts_from_the_positions_moved_by_their_rates() {
+    let mut sys = Spy {
+        m: 1.0,
+        k: 4.0,
+        trap: 0.1,
+        failed: None,
+        attempts: Vec::new(),
+    };
+    let (_, ga) = run(&mut sys, &[1.0, 0.0], 0.3, 1e-3, 0.9, 1e-11);
+    assert_eq!(ga.stats().steps_rejected, 1, "{:?}", ga.stats());
+    let failed = sys.failed.unwrap();
+    for (k, &(q, v, h, first)) in sys.attempts.iter().enumerate() {
+        let gap = (first.unwrap() - (q + h * v)).abs();
+        if k > failed && k <= failed + 30 {
+            assert!(
+                gap < 1e-14,
+                "attempt {k}, {} after the failure: {gap:e}",
+                k - failed
+            );
+        } else {
+            assert!(gap > 1e-8, "attempt {k} (failure at {failed}): {gap:e}");
+        }
+    }
+    assert!(sys.attempts.len() > failed + 40);
+}
