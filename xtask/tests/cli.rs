@@ -248,23 +248,34 @@ fn statics_sweep_outside_the_workspace_is_an_error() {
     );
 }
 
-/// Runs `command --scenario short.toml --out DIR/out` with a record of `t_final` seconds and
-/// expects success; returns the output directory.
-fn run_short(dir: &TempDir, command: &str, t_final: f64) -> std::path::PathBuf {
-    let scenario = dir.join("short.toml");
-    std::fs::write(&scenario, format!("[simulation]\nt_final = {t_final}\n")).unwrap();
+/// Runs `command --scenario DIR/scenario.toml --out DIR/out` on a scenario of `text`; returns
+/// the process's output and the output directory.
+fn run_on(dir: &TempDir, command: &str, text: &str) -> (std::process::Output, std::path::PathBuf) {
+    let scenario = dir.join("scenario.toml");
+    std::fs::write(&scenario, text).unwrap();
     let out = dir.join("out");
-    let status = xtask()
+    let output = xtask()
         .args([command, "--scenario"])
         .arg(&scenario)
         .arg("--out")
         .arg(&out)
         .output()
         .unwrap();
+    (output, out)
+}
+
+/// [`run_on`] with a record of `t_final` seconds, expecting success; returns the output
+/// directory.
+fn run_short(dir: &TempDir, command: &str, t_final: f64) -> std::path::PathBuf {
+    let (output, out) = run_on(
+        dir,
+        command,
+        &format!("[simulation]\nt_final = {t_final}\n"),
+    );
     assert!(
-        status.status.success(),
+        output.status.success(),
         "{}",
-        String::from_utf8_lossy(&status.stderr)
+        String::from_utf8_lossy(&output.stderr)
     );
     out
 }
@@ -348,16 +359,7 @@ fn modes_takes_the_controller() {
 #[test]
 fn shaping_refuses_a_bad_scenario_before_work() {
     let dir = TempDir::new("shaping");
-    let scenario = dir.join("bad.toml");
-    std::fs::write(&scenario, "[simulation]\nt_final = -1.0\n").unwrap();
-    let out = dir.join("out");
-    let output = xtask()
-        .args(["shaping", "--scenario"])
-        .arg(&scenario)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let (output, out) = run_on(&dir, "shaping", "[simulation]\nt_final = -1.0\n");
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success());
     assert!(

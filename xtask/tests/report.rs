@@ -188,11 +188,7 @@ fn report_reproduces_the_committed_report() {
 /// a figure per model.
 fn shaping_study_is_sound(out: &Path) {
     let csv = std::fs::read_to_string(out.join("shaping.csv")).unwrap();
-    let rows: Vec<Vec<&str>> = csv
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').collect())
-        .collect();
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(csv_fields).collect();
     assert_eq!(rows.len(), 7 * 3 * 17);
     for r in &rows {
         let residual: f64 = r[6].parse().unwrap();
