@@ -1,5 +1,5 @@
 //! The G-code reader: what it refuses (each error naming the 1-based line and its text) and
-//! what it reads, with Klipper's `gcode_move` semantics (`/work/notes/klipper-planner.md` §2).
+//! what it reads, with Klipper's `gcode_move` semantics (docs/printing.md, "G-code").
 
 use cdpr_printing::gcode::{
     GcodeError, Instruction, LimitChange, Move, MoveKind, Program, Skipped, read,

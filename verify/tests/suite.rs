@@ -22,7 +22,7 @@ mod implicit_adaptive;
 mod lqr_weights;
 #[path = "lumped_references.rs"]
 mod lumped_references;
-#[path = "lumped_spatial.rs"]
+#[path = "lumped_spatial/mod.rs"]
 mod lumped_spatial;
 #[path = "modes.rs"]
 mod modes;

@@ -357,7 +357,7 @@ fn locked_reel_modes_are_the_length_controlled_loops() {
 /// The modes study on lumped lines adds every mode of the robot at rest with its reels locked,
 /// named and in ascending order: the effector's three and each cable's string families (across
 /// and in its vertical plane; the plumb line under the ceiling anchor has two in-plane ones).
-/// Their values are checked against closed forms in verify/tests/lumped_spatial.rs.
+/// Their values are checked against closed forms in verify/tests/lumped_spatial/modes.rs.
 #[test]
 fn the_lumped_lines_modes_are_listed_by_name() {
     let dir = TempDir::new("spatial-modes-lumped");
