@@ -15,6 +15,9 @@ use proptest::prelude::*;
 use std::f64::consts::{PI, SQRT_2};
 use std::fmt::Write;
 
+mod closed_forms;
+mod random_programs;
+
 /// A few ulp of relative round-off: the limits pass through ×1000 (SI → mm) and ÷1000
 /// (mm → SI) and a speed through v² and √, each rounding once.
 const ULPS: f64 = 16.0 * f64::EPSILON;
@@ -314,6 +317,3 @@ fn timeline(expects: &[Expect]) -> Timeline {
     }
     t
 }
-
-mod closed_forms;
-mod random_programs;

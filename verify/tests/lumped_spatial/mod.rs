@@ -14,6 +14,14 @@ use cdpr_verify::irvine::Catenary;
 use nalgebra::Vector3;
 use proptest::prelude::*;
 
+mod modes;
+mod passages;
+mod planar;
+mod reels;
+mod runs;
+mod statics;
+mod tangent;
+
 /// The Hangprinter example's anchors [m] (examples/robots/hangprinter.toml).
 const HANGPRINTER: [[f64; 3]; 4] = [
     [0.0, -1.61098, -0.13153],
@@ -65,14 +73,6 @@ fn holding_if_feasible(
 fn holding(model: &LumpedSpatial, p: &Vector3<f64>) -> cdpr_bench::core::robot::Tensions {
     holding_if_feasible(model, p).expect("a pose whose weight the box holds")
 }
-
-mod modes;
-mod passages;
-mod planar;
-mod reels;
-mod runs;
-mod statics;
-mod tangent;
 
 /// The Hangprinter example's move on lumped lines of `elements` springs and density ρ.
 fn hangprinter_move(kind: &str, elements: usize, density: f64) -> cdpr_bench::SpatialRun {
